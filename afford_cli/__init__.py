@@ -1,0 +1,1 @@
+"""afford_cli: the command line, the only package that touches files or the terminal."""

@@ -1,0 +1,220 @@
+"""Versioned artefact files: one zip per artefact, checked on every read.
+
+Layout (DESIGN.md section 3)::
+
+    manifest.json   format, kind, schema_version, afford_version, created, command, seed,
+                    parents [{kind, sha256}], members {name: sha256}, and report data
+    <name>.npy      arrays, always read with allow_pickle=False
+    <name>.skops    fitted estimators (skops.io), loaded with an explicit trusted-type list
+
+Writing goes to a temporary file beside the target and is renamed into place, so a crash
+never leaves half a file; ``-`` means stdout (or stdin when reading). Reading refuses, with
+one sentence, anything that is not an afford file, the wrong kind, a newer or unmigratable
+schema, a member whose checksum does not match, or an estimator holding an untrusted type.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import io
+import json
+import os
+import sys
+import tempfile
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from afford_cli.errors import AffordError
+
+__all__ = [
+    "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
+    "artifact_bytes", "TRUSTED_TYPES",
+]
+
+FORMAT = "afford"
+#: Bump when the layout changes; teach ``_migrate`` the step from the previous one.
+SCHEMA_VERSION = 1
+MIN_SCHEMA_VERSION = 1
+KINDS = ("interactions", "effects", "features", "model")
+_ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+
+#: Types an estimator member may contain; anything else is refused on load.
+TRUSTED_TYPES: list[str] = []
+
+
+def _version() -> str:
+    try:
+        from importlib.metadata import version
+
+        return version("afford")
+    except Exception:  # pragma: no cover - running from a source tree without install
+        return "0+unknown"
+
+
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _npy_bytes(array: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.save(buf, np.ascontiguousarray(array), allow_pickle=False)
+    return buf.getvalue()
+
+
+@dataclass
+class Artifact:
+    """An artefact read from (or about to be written to) a file."""
+
+    kind: str
+    manifest: dict[str, Any]
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    blobs: dict[str, bytes] = field(default_factory=dict)   # raw .skops members
+    sha256: str = ""
+    source: str = ""
+
+    def parent_ref(self) -> dict[str, str]:
+        return {"kind": self.kind, "sha256": self.sha256}
+
+
+def artifact_bytes(kind: str, arrays: dict[str, np.ndarray], meta: dict[str, Any], *,
+                   parents: list[dict[str, str]] | None = None, seed: int | None = None,
+                   blobs: dict[str, bytes] | None = None, command: list[str] | None = None) -> bytes:
+    """Serialise an artefact to zip bytes (array members are byte-stable for equal arrays)."""
+    if kind not in KINDS:
+        raise ValueError(f"unknown artefact kind {kind!r}")
+    members: dict[str, bytes] = {}
+    for name, arr in sorted(arrays.items()):
+        if arr.dtype == object:
+            raise ValueError(f"array {name!r} has dtype object; artefacts hold plain arrays only")
+        members[f"{name}.npy"] = _npy_bytes(arr)
+    for name, blob in sorted((blobs or {}).items()):
+        members[f"{name}.skops"] = blob
+    manifest = {
+        "format": FORMAT,
+        "kind": kind,
+        "schema_version": SCHEMA_VERSION,
+        "afford_version": _version(),
+        "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "command": list(sys.argv if command is None else command),
+        "seed": seed,
+        "parents": list(parents or []),
+        "members": {name: _sha256(data) for name, data in members.items()},
+        **meta,
+    }
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        for name, data in [("manifest.json", json.dumps(manifest, indent=1, sort_keys=True).encode())] + list(members.items()):
+            info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            zf.writestr(info, data)
+    return buf.getvalue()
+
+
+def write_artifact(path: str, data: bytes) -> None:
+    """Write artefact bytes to ``path`` atomically, or to stdout for ``-``."""
+    if path == "-":
+        out = sys.stdout.buffer
+        out.write(data)
+        out.flush()
+        return
+    target = Path(path)
+    if target.is_dir():
+        raise AffordError(f"{path} is a directory; give a file name for the artefact")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.exists():
+        raise AffordError(f"cannot write {path}: the directory {parent} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def _read_source(path: str) -> bytes:
+    if path == "-":
+        if sys.stdin.isatty():
+            raise AffordError("no artefact on standard input (pipe one in, or give a file name)")
+        return sys.stdin.buffer.read()
+    p = Path(path)
+    if not p.exists():
+        raise AffordError(f"{path} does not exist")
+    if p.is_dir():
+        raise AffordError(f"{path} is a directory, not an afford file")
+    return p.read_bytes()
+
+
+def _migrate(manifest: dict) -> dict:
+    """Bring an older manifest up to SCHEMA_VERSION (nothing to do yet: there is only v1)."""
+    return manifest
+
+
+def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data: bytes | None = None) -> Artifact:
+    """Read and verify an artefact; ``kinds`` lists what the caller accepts."""
+    name = "standard input" if path == "-" else path
+    raw = _read_source(path) if data is None else data
+    if not raw:
+        raise AffordError(f"{name} is empty, not an afford file")
+    try:
+        zf = zipfile.ZipFile(io.BytesIO(raw))
+        manifest = json.loads(zf.read("manifest.json"))
+    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError):
+        raise AffordError(f"{name} is not an afford file") from None
+    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
+        raise AffordError(f"{name} is not an afford file")
+    kind = manifest.get("kind")
+    version = manifest.get("schema_version")
+    if not isinstance(version, int):
+        raise AffordError(f"{name} has no valid schema_version; it is corrupt or was edited")
+    if version > SCHEMA_VERSION:
+        raise AffordError(f"{name} was written with artefact schema {version}, newer than this afford "
+                          f"understands ({SCHEMA_VERSION}); upgrade afford")
+    if version < MIN_SCHEMA_VERSION:
+        raise AffordError(f"{name} uses artefact schema {version}, which this afford can no longer read "
+                          f"(oldest supported: {MIN_SCHEMA_VERSION}); re-create it")
+    manifest = _migrate(manifest)
+    if kinds is not None:
+        wanted = (kinds,) if isinstance(kinds, str) else tuple(kinds)
+        if kind not in wanted:
+            raise AffordError(f"{name} is a {kind!r} artefact, but this command needs {' or '.join(repr(k) for k in wanted)}")
+    members = manifest.get("members")
+    if not isinstance(members, dict):
+        raise AffordError(f"{name} lists no members; it is corrupt or was edited")
+    present = set(zf.namelist()) - {"manifest.json"}
+    if present != set(members):
+        extra = sorted(present - set(members)) or sorted(set(members) - present)
+        raise AffordError(f"{name} is corrupt or was edited: member {extra[0]} does not match the manifest")
+    arrays: dict[str, np.ndarray] = {}
+    blobs: dict[str, bytes] = {}
+    for member, digest in sorted(members.items()):
+        try:
+            blob = zf.read(member)
+        except (zipfile.BadZipFile, OSError, EOFError):  # zlib errors surface as BadZipFile
+            raise AffordError(f"{name} is corrupt: member {member} cannot be read") from None
+        except Exception:
+            raise AffordError(f"{name} is corrupt: member {member} cannot be read") from None
+        if _sha256(blob) != digest:
+            raise AffordError(f"{name} is corrupt or was edited: checksum mismatch in {member}")
+        if member.endswith(".npy"):
+            try:
+                arrays[member[:-4]] = np.load(io.BytesIO(blob), allow_pickle=False)
+            except ValueError:
+                raise AffordError(f"{name} holds an array member {member} that needs pickle; refused") from None
+        elif member.endswith(".skops"):
+            blobs[member[:-6]] = blob
+        else:
+            raise AffordError(f"{name} holds an unknown member {member}")
+    return Artifact(kind=kind, manifest=manifest, arrays=arrays, blobs=blobs, sha256=_sha256(raw), source=name)

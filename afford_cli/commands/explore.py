@@ -1,0 +1,97 @@
+"""``afford explore``: a robot plays with objects; writes an ``interactions`` artefact."""
+
+from __future__ import annotations
+
+import time
+from typing import Annotated, Optional
+
+import typer
+from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.datasets import behaviour_counts, interactions_members, outcome_table
+from afford_cli.commands.inspect import render_outcome_table
+from afford_cli.errors import AffordError
+from afford_cli.options import Json, OutputPath, SceneName, Seed, Workers
+from afford_cli.output import Output
+
+
+def make_scene(name: str, size_min: float | None = None, size_max: float | None = None):
+    """Instantiate a registered scene, applying size options where given."""
+    from dataclasses import replace
+
+    from sim.registry import SceneNotFound, get_scene
+
+    try:
+        cls = get_scene(name)
+    except SceneNotFound as exc:
+        raise AffordError(str(exc)) from None
+    scene = cls()
+    if size_min is not None or size_max is not None:
+        lo, hi = scene.config.size_range
+        lo = lo if size_min is None else size_min
+        hi = hi if size_max is None else size_max
+        if lo > hi:
+            raise AffordError(f"--size-min ({lo}) is larger than --size-max ({hi})")
+        scene = cls(replace(scene.config, size_range=(lo, hi)))
+    return scene
+
+
+def run_explore(out: Output, scene, *, episodes: int | None, interactions: int | None, seed: int,
+                workers: int, max_steps: int):
+    """Explore with a progress bar; returns (data, seconds)."""
+    from sim.explore import explore as run
+
+    total = episodes if episodes is not None else interactions
+    unit = "episodes" if episodes is not None else "interactions"
+    start = time.perf_counter()
+    with out.progress(f"exploring {scene.name} ({unit})", total) as update:
+        data = run(scene, episodes=episodes, interactions=interactions, seed=seed, workers=workers,
+                   max_steps=max_steps, progress=lambda done, _total: update(done))
+    return data, time.perf_counter() - start
+
+
+def summary(data, seconds: float) -> dict:
+    import numpy as np
+
+    return {
+        "interactions": len(data),
+        "episodes": int(np.unique(data.episode).size),
+        "seconds": round(seconds, 3),
+        "interactions_per_second": round(len(data) / seconds, 2) if seconds > 0 else None,
+        "counts": behaviour_counts(data),
+    }
+
+
+def explore(
+    output: OutputPath,
+    scene: SceneName = "table",
+    episodes: Annotated[Optional[int], typer.Option("--episodes", "-n", min=1, help="Exploration episodes (trials of Algorithm 5).")] = None,
+    interactions: Annotated[Optional[int], typer.Option("--interactions", min=1, help="Stop once this many interactions are recorded (instead of --episodes).")] = None,
+    seed: Seed = 0,
+    workers: Workers = 1,
+    max_steps: Annotated[int, typer.Option("--max-steps", min=1, help="Most behaviours per episode.")] = 10,
+    size_min: Annotated[Optional[float], typer.Option("--size-min", help="Smallest object dimension, metres.")] = None,
+    size_max: Annotated[Optional[float], typer.Option("--size-max", help="Largest object dimension, metres.")] = None,
+    json: Json = False,
+) -> None:
+    """Let the robot explore: random objects, random behaviours, effects recorded (Algorithm 5)."""
+    if episodes is not None and interactions is not None:
+        raise typer.BadParameter("give --episodes or --interactions, not both")
+    if episodes is None and interactions is None:
+        episodes = 100
+    out = Output(json, stdout_busy=output == "-")
+    sc = make_scene(scene, size_min, size_max)
+    data, seconds = run_explore(out, sc, episodes=episodes, interactions=interactions, seed=seed,
+                                workers=workers, max_steps=max_steps)
+    if len(data) == 0:
+        raise AffordError("exploration recorded no interactions (no object was ever seen)")
+    arrays, meta = interactions_members(data)
+    write_artifact(output, artifact_bytes("interactions", arrays, meta, seed=seed))
+    result = summary(data, seconds)
+    result["output"] = output
+
+    def render(console):
+        console.print(f"[bold]explored[/] {result['interactions']} interactions in {result['episodes']} episodes, "
+                      f"{result['seconds']:.1f} s ({result['interactions_per_second']}/s) -> {output}")
+        render_outcome_table(console, outcome_table(data))
+
+    out.result(result, render)

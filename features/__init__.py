@@ -1,0 +1,21 @@
+"""Perception: range images to object feature vectors (imports nothing else of afford)."""
+
+from features.interactions import OUTCOMES, Interactions
+from features.detect import Detection, RangeImage, RegionOfInterest, detect_objects
+from features.objects import N_OBJECT_FEATURES, object_features, perceive, track
+from features.schema import FeatureSchema, object_schema
+
+__all__ = [
+    "Detection",
+    "FeatureSchema",
+    "Interactions",
+    "OUTCOMES",
+    "N_OBJECT_FEATURES",
+    "RangeImage",
+    "RegionOfInterest",
+    "detect_objects",
+    "object_features",
+    "object_schema",
+    "perceive",
+    "track",
+]

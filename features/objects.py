@@ -1,0 +1,91 @@
+"""The chapter 8 object feature vector, and keeping track of objects between looks.
+
+``object_features`` turns one detection into the 43 numbers of thesis 8.3.1.
+``track`` matches a new look to the objects the robot already knows, so that an object
+that vanished keeps its last seen position and shape with visibility 0 (its effect is
+then a drop of visibility only, as DESIGN.md section 1 asks).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from features.detect import Detection, RangeImage, RegionOfInterest, detect_objects
+from features.normals import grid_normals, normal_angles
+from features.schema import N_ANGLE_BINS, object_schema
+
+__all__ = ["object_features", "perceive", "track", "N_OBJECT_FEATURES", "POSITION", "SHAPE"]
+
+_SCHEMA = object_schema()
+N_OBJECT_FEATURES = len(_SCHEMA)
+POSITION = _SCHEMA.channel_indices("position")
+SHAPE = _SCHEMA.channel_indices("shape")
+
+_ELEVATION_EDGES = np.linspace(-90.0, 90.0, N_ANGLE_BINS + 1)
+_AZIMUTH_EDGES = np.linspace(-180.0, 180.0, N_ANGLE_BINS + 1)
+
+
+def _histogram(values: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    counts, _ = np.histogram(values, bins=edges)
+    total = counts.sum()
+    return counts / total if total else counts.astype(float)
+
+
+def object_features(detection: Detection, camera: np.ndarray, normal_step: int = 5) -> np.ndarray:
+    """The 43-feature vector of one detected object (visibility 1)."""
+    cloud = detection.cloud()
+    lo = cloud.min(axis=0)
+    hi = cloud.max(axis=0)
+    position = np.column_stack([lo, hi]).ravel()  # x_min, x_max, y_min, y_max, z_min, z_max
+    step = normal_step
+    normals = grid_normals(detection.points, camera, n=step)
+    while normals.shape[0] < 3 and step > 1:  # a small object: use nearer neighbours
+        step -= 1
+        normals = grid_normals(detection.points, camera, n=step)
+    elevation, azimuth = normal_angles(normals)
+    shape = np.concatenate([_histogram(elevation, _ELEVATION_EDGES), _histogram(azimuth, _AZIMUTH_EDGES)])
+    return np.concatenate([[1.0], position, shape])
+
+
+def perceive(image: RangeImage, roi: RegionOfInterest, **detect_options) -> np.ndarray:
+    """Detect every object in a range image; return their feature vectors (k, 43)."""
+    detections = detect_objects(image, roi, **detect_options)
+    if not detections:
+        return np.empty((0, N_OBJECT_FEATURES))
+    return np.stack([object_features(d, image.origin) for d in detections])
+
+
+def _centre(f: np.ndarray) -> np.ndarray:
+    p = f[..., POSITION]
+    return np.stack([(p[..., 0] + p[..., 1]) / 2, (p[..., 2] + p[..., 3]) / 2, (p[..., 4] + p[..., 5]) / 2], axis=-1)
+
+
+def track(known: np.ndarray, seen: np.ndarray, gate: float = 0.35) -> np.ndarray:
+    """Match a new look to known objects by their centres.
+
+    Parameters
+    ----------
+    known : (k, 43) array
+        The objects as last perceived (visibility 0 rows are vanished ones).
+    seen : (m, 43) array
+        This look's detections.
+    gate : float
+        Centres further apart than this (metres) are not the same object.
+
+    Returns
+    -------
+    (k, 43) array: each known object updated from its match; an unmatched one keeps its
+    last features with visibility 0. Detections that match nothing are ignored (the
+    robot tracks the objects it started with).
+    """
+    out = known.copy()
+    out[:, 0] = 0.0
+    if known.shape[0] == 0 or seen.shape[0] == 0:
+        return out
+    cost = np.linalg.norm(_centre(known)[:, None, :] - _centre(seen)[None, :, :], axis=2)
+    rows, cols = linear_sum_assignment(cost)
+    for r, c in zip(rows, cols):
+        if cost[r, c] <= gate:
+            out[r] = seen[c]
+    return out

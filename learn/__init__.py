@@ -1,0 +1,1 @@
+"""Learning affordances: effect categories, relevant features, predictors (imports features only)."""

@@ -1,0 +1,188 @@
+"""Exploration (thesis Algorithm 5): play with random objects, record what happens.
+
+Per episode (trial): a fresh world with one random object; while the object is visible
+and the last behaviour moved it (perceived), perceive, run a random behaviour with random
+parameters, perceive again, and record <f^(), b, alpha, f^(b)> with ground truth.
+
+Episode ``i`` draws everything from its own generator, seeded by ``(seed, i)``, so the
+rows are the same whatever the number of workers and whichever worker ran the episode.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Iterator
+
+import numpy as np
+
+from features import Interactions
+from features.interactions import OUTCOMES
+from features.objects import POSITION
+from sim.objects import SHAPES, ObjectSpec
+from sim.world import ObjectTruth, TableWorld
+
+__all__ = ["explore", "run_episode", "episode_rng", "outcome_label", "MOVED", "LIFTED"]
+
+#: A perceived position change above this (metres) counts as "the object moved".
+MOVED = 0.015
+#: Ground truth: an object whose bottom ends this far above the table top was lifted.
+LIFTED = 0.05
+
+
+def episode_rng(seed: int, episode: int) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(episode,)))
+
+
+def outcome_label(world: TableWorld, before: ObjectTruth, after: ObjectTruth, visible: bool) -> int:
+    """The first ground-truth label that applies (index into OUTCOMES)."""
+    top = world.config.table_top
+    if after.position[2] < top:
+        return OUTCOMES.index("fell")
+    if not visible:
+        return OUTCOMES.index("left-view")
+    if after.bottom >= top + LIFTED:
+        return OUTCOMES.index("lifted")
+    moved = float(np.linalg.norm(after.position - before.position))
+    turned = 2 * np.degrees(np.arccos(np.clip(abs(float(np.dot(after.quaternion, before.quaternion))), 0, 1)))
+    if moved >= 0.02 or turned >= 10.0:
+        return OUTCOMES.index("dragged")
+    return OUTCOMES.index("no-change")
+
+
+@dataclass
+class _Rows:
+    before: list
+    after: list
+    behavior: list
+    params: list
+    step: list
+    truth: dict
+
+
+def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interactions:
+    """One trial of Algorithm 5 in a fresh world; returns its rows."""
+    rng = episode_rng(seed, episode)
+    spec = scene.sample_object(rng)
+    world = scene.build([spec], rng)
+    behaviors = scene.behaviors
+    n_params = max((len(b.parameters) for b in behaviors), default=0)
+    rows = _Rows([], [], [], [], [], {k: [] for k in (
+        "shape", "size", "pose_before", "pose_after", "in_hand_before", "in_hand_after",
+        "reachable", "contact", "outcome")})
+    f = world.perceive()
+    steps = 0
+    while f.shape[0] and f[0, 0] == 1.0 and steps < max_steps:
+        b = int(rng.integers(len(behaviors)))
+        behavior = behaviors[b]
+        alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
+        t0 = world.truth()[0]
+        world.contact = False
+        execution = behavior(world, f[0], alpha)
+        world.settle()
+        f1 = world.perceive()
+        t1 = world.truth()[0]
+        rows.before.append(f[0])
+        rows.after.append(f1[0])
+        rows.behavior.append(b)
+        padded = np.zeros(n_params)
+        padded[: alpha.size] = alpha
+        rows.params.append(padded)
+        rows.step.append(steps)
+        tr = rows.truth
+        tr["shape"].append(SHAPES.index(spec.shape))
+        size = np.full(3, np.nan)
+        size[: len(spec.size)] = spec.size
+        tr["size"].append(size)
+        tr["pose_before"].append(np.concatenate([t0.position, t0.quaternion]))
+        tr["pose_after"].append(np.concatenate([t1.position, t1.quaternion]))
+        tr["in_hand_before"].append(t0.in_hand)
+        tr["in_hand_after"].append(t1.in_hand)
+        tr["reachable"].append(execution.executed)
+        tr["contact"].append(world.contact)
+        tr["outcome"].append(outcome_label(world, t0, t1, bool(f1[0, 0])))
+        steps += 1
+        moved = np.abs(f1[0, POSITION] - f[0, POSITION]).max() > MOVED
+        f = f1
+        if not moved:
+            break
+    n = len(rows.before)
+    d = len(scene.schema)
+    dtypes = {"shape": np.int8, "outcome": np.int8, "in_hand_before": bool, "in_hand_after": bool,
+              "reachable": bool, "contact": bool}
+    truth = {}
+    for k, v in rows.truth.items():
+        width = {"size": (3,), "pose_before": (7,), "pose_after": (7,)}.get(k, ())
+        truth[k] = np.array(v, dtype=dtypes.get(k, np.float64)).reshape((n, *width))
+    return Interactions(
+        schema=scene.schema,
+        behaviors=[b.to_json() for b in behaviors],
+        before=np.array(rows.before, dtype=np.float64).reshape(n, d),
+        after=np.array(rows.after, dtype=np.float64).reshape(n, d),
+        behavior=np.array(rows.behavior, dtype=np.int16),
+        params=np.array(rows.params, dtype=np.float64).reshape(n, n_params),
+        episode=np.full(n, episode, dtype=np.int32),
+        step=np.array(rows.step, dtype=np.int16),
+        truth=truth,
+        shapes=list(SHAPES),
+        scene=scene.describe(),
+    )
+
+
+def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int) -> list[Interactions]:
+    return [run_episode(scene, seed, e, max_steps) for e in episodes]
+
+
+def _chunks(start: int, stop: int, size: int) -> Iterator[list[int]]:
+    for a in range(start, stop, size):
+        yield list(range(a, min(a + size, stop)))
+
+
+def explore(
+    scene,
+    *,
+    episodes: int | None = None,
+    interactions: int | None = None,
+    seed: int = 0,
+    workers: int = 1,
+    max_steps: int = 10,
+    progress: Callable[[int, int], None] | None = None,
+    chunk: int = 8,
+) -> Interactions:
+    """Run exploration episodes; stop after ``episodes`` or once ``interactions`` rows exist.
+
+    ``progress(done, total)`` is called as chunks finish (in episodes, or in rows when
+    ``interactions`` is given). With ``interactions`` the result is cut to exactly that
+    many rows, in episode order, so it too is the same for any number of workers.
+    """
+    if (episodes is None) == (interactions is None):
+        raise ValueError("give either episodes or interactions")
+    from joblib import Parallel, delayed
+
+    parts: list[Interactions] = []
+    total_rows = 0
+    next_episode = 0
+    target = episodes if episodes is not None else interactions
+    with Parallel(n_jobs=workers, return_as="generator") as parallel:
+        while True:
+            if episodes is not None:
+                if next_episode >= episodes:
+                    break
+                stop = episodes
+            else:
+                if total_rows >= interactions:
+                    break
+                # Rows per episode average about two: ask for what is likely missing.
+                need = max(workers * chunk, int((interactions - total_rows) / 1.8) + 1)
+                stop = next_episode + need
+            jobs = (delayed(_run_chunk)(scene, seed, eps, max_steps) for eps in _chunks(next_episode, stop, chunk))
+            for result in parallel(jobs):
+                parts.extend(result)
+                total_rows += sum(len(r) for r in result)
+                if progress is not None:
+                    done = len(parts) if episodes is not None else min(total_rows, interactions)
+                    progress(done, target)
+            next_episode = stop
+    data = Interactions.concatenate(parts)
+    if interactions is not None:
+        data = data.subset(np.arange(interactions))
+    return data

@@ -1,0 +1,184 @@
+"""Objects on the table: their specification, their physics body and their mesh.
+
+An :class:`ObjectSpec` is plain data (it is what a layout file holds and what ground truth
+records). ``build_object`` turns it into a SAPIEN rigid body whose mass follows from its
+volume, and ``object_mesh`` into the triangle mesh the range camera sees. Both use the
+same local frame: the body's origin at its centre, a cylinder's axis along local x (SAPIEN's
+convention), standing up for ``cylinder`` and lying for ``lying-cylinder``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import open3d as o3d
+import sapien
+
+__all__ = ["SHAPES", "ObjectSpec", "build_object", "object_mesh", "yaw_quaternion"]
+
+#: The object shapes the scenes know, in the order ground truth stores them.
+SHAPES = ("box", "cylinder", "lying-cylinder", "sphere")
+
+# Rotation of a cylinder's local frame so that its axis (x) points up (z).
+_UPRIGHT = np.array([math.cos(-math.pi / 4), 0.0, math.sin(-math.pi / 4), 0.0])
+
+
+def yaw_quaternion(yaw_deg: float) -> np.ndarray:
+    """Quaternion (w, x, y, z) of a rotation about the vertical axis."""
+    half = math.radians(yaw_deg) / 2
+    return np.array([math.cos(half), 0.0, 0.0, math.sin(half)])
+
+
+@dataclass(frozen=True)
+class ObjectSpec:
+    """One object: what it is, how big, where it stands.
+
+    Parameters
+    ----------
+    shape : str
+        One of :data:`SHAPES`.
+    size : tuple of float
+        Metres: box edges (x, y, z in the object's frame), ``(diameter, length)`` for
+        cylinders, ``(diameter,)`` for spheres.
+    position : tuple of float
+        ``(x, y)`` of the object's centre on the table top, robot frame.
+    yaw : float
+        Degrees about the vertical axis.
+    held : bool
+        The object starts grasped and lifted by the hand.
+    """
+
+    shape: str
+    size: tuple[float, ...]
+    position: tuple[float, float]
+    yaw: float = 0.0
+    held: bool = False
+
+    def __post_init__(self) -> None:
+        if self.shape not in SHAPES:
+            raise ValueError(f"unknown shape {self.shape!r}; known shapes: {', '.join(SHAPES)}")
+        want = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}[self.shape]
+        if len(self.size) != want:
+            raise ValueError(f"a {self.shape} needs {want} size value(s), got {len(self.size)}")
+        if any(not (0.01 <= s <= 1.0) for s in self.size):
+            raise ValueError(f"object sizes must be between 0.01 and 1.0 m, got {list(self.size)}")
+        if len(self.position) != 2:
+            raise ValueError("an object's position is [x, y] on the table")
+
+    @property
+    def extents(self) -> np.ndarray:
+        """Full extents (x, y, z) in the object's own frame before yaw."""
+        s = self.size
+        if self.shape == "box":
+            return np.array(s, dtype=float)
+        if self.shape == "sphere":
+            return np.array([s[0]] * 3, dtype=float)
+        d, length = s
+        if self.shape == "cylinder":
+            return np.array([d, d, length], dtype=float)
+        return np.array([length, d, d], dtype=float)  # lying: axis along local x
+
+    @property
+    def height(self) -> float:
+        return float(self.extents[2])
+
+    @property
+    def footprint_radius(self) -> float:
+        """Half the diagonal of the object's footprint: how far it reaches from its centre."""
+        e = self.extents
+        return float(math.hypot(e[0], e[1]) / 2)
+
+    @property
+    def volume(self) -> float:
+        s = self.size
+        if self.shape == "box":
+            return float(s[0] * s[1] * s[2])
+        if self.shape == "sphere":
+            return float(math.pi * s[0] ** 3 / 6)
+        return float(math.pi * (s[0] / 2) ** 2 * s[1])
+
+    def to_dict(self) -> dict:
+        return {"shape": self.shape, "size": list(self.size), "position": list(self.position),
+                "yaw": self.yaw, "held": self.held}
+
+    def pose(self, table_top: float) -> sapien.Pose:
+        """Resting pose on the table top."""
+        return sapien.Pose([self.position[0], self.position[1], table_top + self.height / 2],
+                           yaw_quaternion(self.yaw))
+
+    def _local_rotation(self) -> np.ndarray:
+        return _UPRIGHT if self.shape == "cylinder" else np.array([1.0, 0.0, 0.0, 0.0])
+
+
+@dataclass
+class _Cache:
+    meshes: dict = field(default_factory=dict)
+
+
+_CACHE = _Cache()
+
+
+#: Sides of the prism that stands for a cylinder, in physics and in the camera's mesh alike.
+CYLINDER_SIDES = 32
+
+
+def _prism(radius: float, length: float) -> np.ndarray:
+    """Vertices of a CYLINDER_SIDES-gon prism along local x."""
+    a = np.linspace(0.0, 2 * math.pi, CYLINDER_SIDES, endpoint=False)
+    ring = np.column_stack([np.cos(a), np.sin(a)]) * radius
+    ends = [np.column_stack([np.full(len(a), x), ring]) for x in (-length / 2, length / 2)]
+    return np.concatenate(ends).astype(np.float32)
+
+
+def build_object(scene: sapien.Scene, spec: ObjectSpec, table_top: float, density: float,
+                 material: sapien.physx.PhysxMaterial) -> sapien.Entity:
+    """Add the object's rigid body to ``scene``, resting on the table top.
+
+    A cylinder is a 32-sided convex prism rather than PhysX's exact cylinder: on the exact
+    one a lying cylinder that has just slid to rest starts rolling by itself (contact
+    jitter with nothing to stop it), while the prism's narrow facets hold it still yet
+    let it roll when pushed across its axis.
+    """
+    body = sapien.physx.PhysxRigidDynamicComponent()
+    if spec.shape == "box":
+        shape = sapien.physx.PhysxCollisionShapeBox(half_size=np.array(spec.size) / 2, material=material)
+    elif spec.shape == "sphere":
+        shape = sapien.physx.PhysxCollisionShapeSphere(radius=spec.size[0] / 2, material=material)
+    else:
+        shape = sapien.physx.PhysxCollisionShapeConvexMesh(
+            vertices=_prism(spec.size[0] / 2, spec.size[1]), scale=np.ones(3, dtype=np.float32), material=material)
+        shape.local_pose = sapien.Pose(q=spec._local_rotation())
+    shape.set_density(density)
+    body.attach(shape)
+    entity = sapien.Entity()
+    entity.name = f"object-{spec.shape}"
+    entity.add_component(body)
+    entity.pose = spec.pose(table_top)
+    scene.add_entity(entity)
+    return entity
+
+
+def object_mesh(spec: ObjectSpec) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (in the body frame) and triangles of the object's surface."""
+    key = (spec.shape, tuple(spec.size))
+    hit = _CACHE.meshes.get(key)
+    if hit is not None:
+        return hit
+    if spec.shape == "box":
+        mesh = o3d.geometry.TriangleMesh.create_box(*spec.size)
+        mesh.translate(-np.array(spec.size) / 2)
+    elif spec.shape == "sphere":
+        mesh = o3d.geometry.TriangleMesh.create_sphere(radius=spec.size[0] / 2, resolution=16)
+    else:
+        # Open3D's cylinder stands along z; rotate it onto the body's local axis.
+        mesh = o3d.geometry.TriangleMesh.create_cylinder(radius=spec.size[0] / 2, height=spec.size[1],
+                                                         resolution=CYLINDER_SIDES, split=1)
+        if spec.shape == "lying-cylinder":
+            mesh.rotate(o3d.geometry.get_rotation_matrix_from_xyz((0.0, math.pi / 2, 0.0)), center=(0, 0, 0))
+    result = (np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.triangles, dtype=np.uint32))
+    if len(_CACHE.meshes) > 512:
+        _CACHE.meshes.clear()
+    _CACHE.meshes[key] = result
+    return result

@@ -1,0 +1,47 @@
+"""Scenes register by name (``@register_scene("table")``), one scene per file.
+
+Importing ``sim.scenes`` registers every scene in it. ``get_scene`` raises
+:class:`SceneNotFound` with the list of known names.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, TypeVar
+
+__all__ = ["register_scene", "get_scene", "scene_names", "SceneNotFound"]
+
+_SCENES: dict[str, type] = {}
+T = TypeVar("T", bound=type)
+
+
+class SceneNotFound(KeyError):
+    def __str__(self) -> str:  # KeyError quotes its message otherwise
+        return str(self.args[0])
+
+
+def register_scene(name: str) -> Callable[[T], T]:
+    def wrap(cls: T) -> T:
+        if name in _SCENES and _SCENES[name] is not cls:
+            raise ValueError(f"a scene named {name!r} is registered already")
+        cls.name = name  # type: ignore[attr-defined]
+        _SCENES[name] = cls
+        return cls
+
+    return wrap
+
+
+def _load() -> None:
+    import sim.scenes  # noqa: F401  (registers the scenes)
+
+
+def scene_names() -> list[str]:
+    _load()
+    return sorted(_SCENES)
+
+
+def get_scene(name: str) -> type:
+    _load()
+    try:
+        return _SCENES[name]
+    except KeyError:
+        raise SceneNotFound(f"unknown scene {name!r}; known scenes: {', '.join(sorted(_SCENES))}") from None

@@ -1,0 +1,125 @@
+"""``table``: one robot hand, a table, objects to push and lift (thesis chapter 8).
+
+What the robot has
+    A two-finger hand on a gantry arm whose reach is a disc of 1.0 m about its base
+    (``sim.hand``), and a range camera to its right, behind and above the table
+    (176 x 144 rays 0.23 deg apart, 3 mm range noise, ``sim.camera``).
+
+The world
+    A table 100 cm wide and 70 cm deep, its near edge 40 cm in front of the robot, its top
+    75 cm above the floor; about a fifth of it lies beyond the arm's reach.
+
+What is randomised (per episode, from the episode's seed)
+    One object: box, upright cylinder, lying cylinder or sphere (equally likely); each
+    dimension uniform in ``size_range`` (default 8-40 cm); position uniform over the part
+    of the table where the object fits; yaw uniform in [0, 360). Mass follows from the
+    volume at 300 kg/m^3. Range noise.
+
+What the behaviours do (``sim.behaviors``)
+    ``push-forward``, ``push-left``, ``push-right``, ``lift``, aimed at the perceived object.
+
+What ground truth is kept (for reports and evaluation, never for learning)
+    Shape and size, poses before and after, in hand before and after, reachable (the
+    approach point was within reach and the hand moved), contact (the hand touched the
+    object), and one outcome label: ``fell``, ``left-view``, ``lifted``, ``dragged`` or
+    ``no-change`` (first that applies).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from features import object_schema
+from sim.behaviors import TABLE_BEHAVIORS
+from sim.camera import RangeCamera
+from sim.objects import SHAPES, ObjectSpec
+from sim.registry import register_scene
+from sim.world import TableConfig, TableWorld
+
+__all__ = ["TableScene", "TableSceneConfig"]
+
+
+@dataclass(frozen=True)
+class TableSceneConfig:
+    """What is randomised, and the world's fixed settings."""
+
+    size_range: tuple[float, float] = (0.08, 0.40)
+    """Each object dimension is uniform in this range (metres)."""
+    shapes: tuple[str, ...] = SHAPES
+    """Shapes to draw from, equally likely."""
+    world: TableConfig = field(default_factory=TableConfig)
+    """Table, hand, camera and physics settings."""
+
+    def __post_init__(self) -> None:
+        lo, hi = self.size_range
+        if not (0.02 <= lo <= hi <= 0.6):
+            raise ValueError(f"object sizes must satisfy 0.02 <= min <= max <= 0.6 m, got {lo} and {hi}")
+        for s in self.shapes:
+            if s not in SHAPES:
+                raise ValueError(f"unknown shape {s!r}; known shapes: {', '.join(SHAPES)}")
+
+
+@register_scene("table")
+class TableScene:
+    """The chapter 8 tabletop (see the module docstring for its task sheet)."""
+
+    name = "table"
+    behaviors = TABLE_BEHAVIORS
+    summary = "a hand pushes and lifts one random object on a table (thesis chapter 8)"
+
+    def __init__(self, config: TableSceneConfig | None = None):
+        self.config = config or TableSceneConfig()
+        self._camera: RangeCamera | None = None
+
+    @property
+    def schema(self):
+        return object_schema()
+
+    def describe(self) -> dict:
+        """The configuration as plain data, stored in every artefact."""
+        d = asdict(self.config)
+        d["name"] = self.name
+        return d
+
+    def sample_object(self, rng: np.random.Generator) -> ObjectSpec:
+        c = self.config
+        shape = c.shapes[int(rng.integers(len(c.shapes)))]
+        lo, hi = c.size_range
+        n = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}[shape]
+        size = tuple(float(round(v, 4)) for v in rng.uniform(lo, hi, size=n))
+        yaw = float(rng.uniform(0.0, 360.0))
+        probe = ObjectSpec(shape, size, (0.0, 0.0), yaw)
+        e = probe.extents
+        # Half extents of the yawed footprint, so the object starts wholly on the table.
+        th = math.radians(yaw)
+        hx = (abs(math.cos(th)) * e[0] + abs(math.sin(th)) * e[1]) / 2
+        hy = (abs(math.sin(th)) * e[0] + abs(math.cos(th)) * e[1]) / 2
+        w = c.world
+        x = float(rng.uniform(w.table_near + hx, max(w.table_near + hx, w.table_far - hx)))
+        y = float(rng.uniform(-w.table_width / 2 + hy, max(-w.table_width / 2 + hy, w.table_width / 2 - hy)))
+        return ObjectSpec(shape, size, (round(x, 4), round(y, 4)), round(yaw, 3))
+
+    def sample_objects(self, rng: np.random.Generator, n: int = 1, min_gap: float = 0.05,
+                       tries: int = 200) -> list[ObjectSpec]:
+        """``n`` random objects whose footprints keep ``min_gap`` apart (where possible)."""
+        out: list[ObjectSpec] = []
+        for _ in range(tries):
+            if len(out) == n:
+                break
+            cand = self.sample_object(rng)
+            ok = all(math.dist(cand.position, o.position) >= cand.footprint_radius + o.footprint_radius + min_gap
+                     for o in out)
+            if ok:
+                out.append(cand)
+        if len(out) < n:
+            raise ValueError(f"could not place {n} objects apart on the table; try smaller sizes")
+        return out
+
+    def build(self, objects: list[ObjectSpec], rng: np.random.Generator) -> TableWorld:
+        """A fresh world with these objects (one per episode: a reused scene carries history)."""
+        if self._camera is None:
+            self._camera = RangeCamera(self.config.world.camera)
+        return TableWorld(self.config.world, objects, rng, camera=self._camera)

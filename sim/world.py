@@ -1,0 +1,219 @@
+"""One physics world per episode: a table, objects, the hand, the range camera.
+
+``TableWorld`` owns a fresh SAPIEN scene (CPU PhysX, collision shapes only: no render
+components, which abort a CPU-only process when the scene is destroyed). It steps physics,
+perceives through the range camera, keeps track of the objects it perceives, and reads out
+ground truth for reports. Behaviours (``sim.behaviors``) drive the hand through it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import sapien
+
+from features import RegionOfInterest, perceive, track
+from features.objects import N_OBJECT_FEATURES
+from sim.camera import CameraConfig, MeshInstance, RangeCamera
+from sim.hand import Hand, HandConfig
+from sim.objects import ObjectSpec, build_object, object_mesh
+
+__all__ = ["TableConfig", "TableWorld", "ObjectTruth"]
+
+
+@dataclass(frozen=True)
+class TableConfig:
+    """The tabletop world of thesis chapter 8 (metres, seconds, kg/m^3)."""
+
+    table_near: float = 0.40          # near edge, in front of the robot
+    table_depth: float = 0.70         # frontal
+    table_width: float = 1.00         # lateral
+    table_top: float = 0.75
+    density: float = 300.0
+    friction: float = 0.5
+    timestep: float = 1 / 60
+    settle_max: float = 4.0           # seconds to let objects come to rest after a behaviour
+    hand: HandConfig = field(default_factory=HandConfig)
+    camera: CameraConfig = field(default_factory=CameraConfig)
+
+    @property
+    def table_far(self) -> float:
+        return self.table_near + self.table_depth
+
+    def roi(self) -> RegionOfInterest:
+        """The volume over the table in which the robot looks for objects."""
+        return RegionOfInterest(
+            x=(self.table_near, self.table_far),
+            y=(-self.table_width / 2, self.table_width / 2),
+            z=(self.table_top + 0.008, self.table_top + 0.80),
+        )
+
+
+@dataclass(frozen=True)
+class ObjectTruth:
+    """What physically is, for evaluation and reports only (never used to learn)."""
+
+    position: np.ndarray     # (3,)
+    quaternion: np.ndarray   # (4,) wxyz
+    bottom: float            # lowest point, metres
+    in_hand: bool
+
+
+def _box_mesh(half: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
+    h = np.asarray(half)
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float) * h
+    faces = np.array([
+        [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+        [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
+    ], dtype=np.uint32)
+    return corners, faces
+
+
+class TableWorld:
+    """A fresh world holding ``objects`` on the table (and the hand at home)."""
+
+    def __init__(self, config: TableConfig, objects: list[ObjectSpec], rng: np.random.Generator,
+                 camera: RangeCamera | None = None):
+        self.config = c = config
+        self.rng = rng
+        self.scene = sapien.Scene(systems=[sapien.physx.PhysxCpuSystem()])
+        self.scene.set_timestep(c.timestep)
+        self.scene.add_ground(0.0, render=False)
+        material = sapien.physx.PhysxMaterial(c.friction, c.friction, 0.0)
+        half_table = (c.table_depth / 2, c.table_width / 2, c.table_top / 2)
+        tb = self.scene.create_actor_builder()
+        tb.add_box_collision(half_size=half_table, material=material)
+        table_pose = sapien.Pose([c.table_near + c.table_depth / 2, 0.0, c.table_top / 2])
+        tb.set_initial_pose(table_pose)
+        self.table = tb.build_static(name="table")
+        self._table_mesh = (*_box_mesh(half_table), np.asarray(table_pose.p), np.array([1.0, 0, 0, 0]))
+        self.hand = Hand(self.scene, c.hand)
+        self._hand_meshes = {link.name: _box_mesh(c.hand.palm_half if link.name == "palm" else c.hand.finger_half)
+                             for link in self.hand.body_links}
+        self.specs = list(objects)
+        self.bodies = [build_object(self.scene, s, c.table_top, c.density, material) for s in objects]
+        self.components = [b.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent) for b in self.bodies]
+        for comp in self.components:
+            comp.set_max_depenetration_velocity(1.0)
+        self.camera = camera or RangeCamera(c.camera)
+        self.holding = False
+        self.contact = False
+        self.steps = 0
+        held = [i for i, s in enumerate(objects) if s.held]
+        if len(held) > 1:
+            raise ValueError("the hand can hold only one object")
+        if held:
+            self._start_held(held[0])
+        self.known = np.empty((0, N_OBJECT_FEATURES))
+
+    # -- physics ---------------------------------------------------------------------------
+    def step(self, n: int = 1, watch_contacts: bool = False) -> None:
+        for _ in range(n):
+            self.scene.step()
+            if watch_contacts and not self.contact:
+                self.contact = self._hand_touches_object()
+        self.steps += n
+
+    def _hand_touches_object(self) -> bool:
+        hand = set(self.hand.body_links)
+        objs = set(self.components)
+        for contact in self.scene.get_contacts():
+            a, b = contact.bodies
+            if (a in hand and b in objs) or (b in hand and a in objs):
+                if any(np.linalg.norm(p.impulse) > 0 for p in contact.points):
+                    return True
+        return False
+
+    def palm_touches_object(self) -> bool:
+        """The hand's touch sense: is the palm pressing on an object?"""
+        palm = self.hand.links["palm"]
+        objs = set(self.components)
+        for contact in self.scene.get_contacts():
+            a, b = contact.bodies
+            if (a is palm and b in objs) or (b is palm and a in objs):
+                if any(np.linalg.norm(p.impulse) > 0 for p in contact.points):
+                    return True
+        return False
+
+    def settle(self) -> None:
+        """Step until every object rests, has fallen below the table, or time runs out."""
+        chunk = 6
+        for _ in range(int(self.config.settle_max / self.config.timestep) // chunk):
+            self.step(chunk)
+            moving = False
+            for comp in self.components:
+                if comp.entity_pose.p[2] < self.config.table_top - 0.1:
+                    continue
+                if np.linalg.norm(comp.linear_velocity) > 0.01 or np.linalg.norm(comp.angular_velocity) > 0.1:
+                    moving = True
+                    break
+            if not moving:
+                return
+
+    def _start_held(self, index: int) -> None:
+        """Put object ``index`` in the closed hand, lifted above its table position."""
+        c = self.config
+        spec = self.specs[index]
+        comp = self.components[index]
+        lift = 0.20
+        centre = np.array([spec.position[0], spec.position[1], c.table_top + spec.height / 2 + lift])
+        yaw = math.radians(45.0)
+        d = np.array([math.cos(yaw), math.sin(yaw), 0.0])
+        comp.set_pose(sapien.Pose(centre, spec.pose(c.table_top).q))
+        palm = centre - d * c.hand.finger_centre
+        # Fingers just clear of the object's widest horizontal extent, then squeeze.
+        width = max(spec.extents[0], spec.extents[1]) / 2
+        opening = min(c.hand.finger_open, width + c.hand.finger_half[1] + 0.002)
+        self.hand.teleport(palm, yaw, opening)
+        self.hand.set_fingers(c.hand.finger_closed)
+        comp.set_linear_velocity(np.zeros(3))
+        self.step(int(0.5 / c.timestep))
+        self.holding = True
+
+    # -- perception ------------------------------------------------------------------------
+    def meshes(self) -> list[MeshInstance]:
+        v, t, p, q = self._table_mesh
+        out = [MeshInstance(v, t, p, q)]
+        for spec, body in zip(self.specs, self.bodies):
+            pose = body.pose
+            v, t = object_mesh(spec)
+            out.append(MeshInstance(v, t, np.asarray(pose.p), np.asarray(pose.q)))
+        for link in self.hand.body_links:
+            pose = link.entity_pose
+            v, t = self._hand_meshes[link.name]
+            out.append(MeshInstance(v, t, np.asarray(pose.p), np.asarray(pose.q), own_body=True))
+        return out
+
+    def look(self) -> np.ndarray:
+        """Detect the objects in view now: (k, 43) feature vectors."""
+        image = self.camera.capture(self.meshes(), self.rng)
+        return perceive(image, self.config.roi())
+
+    def perceive(self) -> np.ndarray:
+        """Perceive and keep track of the objects first seen (vanished ones: visibility 0)."""
+        seen = self.look()
+        if self.known.shape[0] == 0:
+            self.known = seen
+        else:
+            self.known = track(self.known, seen)
+        return self.known.copy()
+
+    # -- ground truth ----------------------------------------------------------------------
+    def truth(self) -> list[ObjectTruth]:
+        fingers = {self.hand.links["finger-left"], self.hand.links["finger-right"]}
+        touching: dict[int, set] = {i: set() for i in range(len(self.components))}
+        index = {comp: i for i, comp in enumerate(self.components)}
+        for contact in self.scene.get_contacts():
+            a, b = contact.bodies
+            for x, y in ((a, b), (b, a)):
+                if x in index and y in fingers:
+                    touching[index[x]].add(y)
+        out = []
+        for i, comp in enumerate(self.components):
+            pose = comp.entity_pose
+            lo, _ = comp.compute_global_aabb_tight()
+            out.append(ObjectTruth(np.asarray(pose.p, dtype=float), np.asarray(pose.q, dtype=float),
+                                   float(lo[2]), len(touching[i]) == 2))
+        return out
