@@ -23,8 +23,8 @@ class CameraConfig:
     width: int = 176
     height: int = 144
     step_deg: float = 0.23
-    position: tuple[float, float, float] = (0.75, -1.45, 1.40)
-    look_at: tuple[float, float, float] = (0.75, 0.0, 0.85)
+    position: tuple[float, float, float] = (0.75, -1.30, 1.80)
+    look_at: tuple[float, float, float] = (0.75, 0.0, 0.80)
     noise: float = 0.003  # metres, standard deviation of the range noise
 
 

@@ -21,7 +21,7 @@ from features.objects import POSITION
 from sim.objects import SHAPES, ObjectSpec
 from sim.world import ObjectTruth, TableWorld
 
-__all__ = ["explore", "run_episode", "episode_rng", "outcome_label", "MOVED", "LIFTED"]
+__all__ = ["explore", "run_episode", "interact", "Step", "episode_rng", "outcome_label", "MOVED", "LIFTED"]
 
 #: A perceived position change above this (metres) counts as "the object moved".
 MOVED = 0.015
@@ -47,6 +47,33 @@ def outcome_label(world: TableWorld, before: ObjectTruth, after: ObjectTruth, vi
     if moved >= 0.02 or turned >= 10.0:
         return OUTCOMES.index("dragged")
     return OUTCOMES.index("no-change")
+
+
+@dataclass(frozen=True)
+class Step:
+    """One interaction: the tracked objects before and after, and what physically happened."""
+
+    before: np.ndarray                 # (k, d) perceived, tracked
+    after: np.ndarray                  # (k, d)
+    truth_before: list[ObjectTruth]    # in the order of the tracked objects
+    truth_after: list[ObjectTruth]
+    executed: bool                     # the arm reached and moved
+    contact: bool                      # the hand touched an object
+    outcomes: list[int]                # per tracked object, index into OUTCOMES
+
+
+def interact(world: TableWorld, behavior, target: int, alpha: np.ndarray | None = None,
+             before: np.ndarray | None = None) -> Step:
+    """Run ``behavior`` on tracked object ``target``, let the world settle, perceive again."""
+    f0 = world.perceive() if before is None else before
+    t0 = world.tracked_truth()
+    world.contact = False
+    execution = behavior(world, f0[target], alpha)
+    world.settle()
+    f1 = world.perceive()
+    t1 = world.tracked_truth()
+    outcomes = [outcome_label(world, a, b, bool(f1[i, 0])) for i, (a, b) in enumerate(zip(t0, t1))]
+    return Step(f0, f1, t0, t1, execution.executed, world.contact, outcomes)
 
 
 @dataclass
@@ -75,12 +102,9 @@ def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interact
         b = int(rng.integers(len(behaviors)))
         behavior = behaviors[b]
         alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
-        t0 = world.truth()[0]
-        world.contact = False
-        execution = behavior(world, f[0], alpha)
-        world.settle()
-        f1 = world.perceive()
-        t1 = world.truth()[0]
+        step = interact(world, behavior, 0, alpha, before=f)
+        f1 = step.after
+        t0, t1 = step.truth_before[0], step.truth_after[0]
         rows.before.append(f[0])
         rows.after.append(f1[0])
         rows.behavior.append(b)
@@ -97,9 +121,9 @@ def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interact
         tr["pose_after"].append(np.concatenate([t1.position, t1.quaternion]))
         tr["in_hand_before"].append(t0.in_hand)
         tr["in_hand_after"].append(t1.in_hand)
-        tr["reachable"].append(execution.executed)
-        tr["contact"].append(world.contact)
-        tr["outcome"].append(outcome_label(world, t0, t1, bool(f1[0, 0])))
+        tr["reachable"].append(step.executed)
+        tr["contact"].append(step.contact)
+        tr["outcome"].append(step.outcomes[0])
         steps += 1
         moved = np.abs(f1[0, POSITION] - f[0, POSITION]).max() > MOVED
         f = f1

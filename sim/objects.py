@@ -126,7 +126,9 @@ CYLINDER_SIDES = 32
 
 def _prism(radius: float, length: float) -> np.ndarray:
     """Vertices of a CYLINDER_SIDES-gon prism along local x."""
-    a = np.linspace(0.0, 2 * math.pi, CYLINDER_SIDES, endpoint=False)
+    # Offset by half a facet: with a vertex straight down a lying cylinder would start
+    # balanced on an edge and roll away at the least touch.
+    a = np.linspace(0.0, 2 * math.pi, CYLINDER_SIDES, endpoint=False) + math.pi / CYLINDER_SIDES
     ring = np.column_stack([np.cos(a), np.sin(a)]) * radius
     ends = [np.column_stack([np.full(len(a), x), ring]) for x in (-length / 2, length / 2)]
     return np.concatenate(ends).astype(np.float32)

@@ -35,6 +35,7 @@ class TableConfig:
     friction: float = 0.5
     timestep: float = 1 / 60
     settle_max: float = 4.0           # seconds to let objects come to rest after a behaviour
+    rolling_damping: float = 0.2      # angular damping of objects (1/s), for rolling resistance
     hand: HandConfig = field(default_factory=HandConfig)
     camera: CameraConfig = field(default_factory=CameraConfig)
 
@@ -97,6 +98,9 @@ class TableWorld:
         self.components = [b.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent) for b in self.bodies]
         for comp in self.components:
             comp.set_max_depenetration_velocity(1.0)
+            # PhysX has no rolling resistance; a little angular damping stands in for it,
+            # so that rolling objects slow down a little as real ones do.
+            comp.set_angular_damping(c.rolling_damping)
         self.camera = camera or RangeCamera(c.camera)
         self.holding = False
         self.contact = False
@@ -107,6 +111,7 @@ class TableWorld:
         if held:
             self._start_held(held[0])
         self.known = np.empty((0, N_OBJECT_FEATURES))
+        self.identity: list[int] = []
 
     # -- physics ---------------------------------------------------------------------------
     def step(self, n: int = 1, watch_contacts: bool = False) -> None:
@@ -161,7 +166,7 @@ class TableWorld:
         centre = np.array([spec.position[0], spec.position[1], c.table_top + spec.height / 2 + lift])
         yaw = math.radians(45.0)
         d = np.array([math.cos(yaw), math.sin(yaw), 0.0])
-        comp.set_pose(sapien.Pose(centre, spec.pose(c.table_top).q))
+        comp.set_entity_pose(sapien.Pose(centre, spec.pose(c.table_top).q))
         palm = centre - d * c.hand.finger_centre
         # Fingers just clear of the object's widest horizontal extent, then squeeze.
         width = max(spec.extents[0], spec.extents[1]) / 2
@@ -196,11 +201,34 @@ class TableWorld:
         seen = self.look()
         if self.known.shape[0] == 0:
             self.known = seen
+            self._identify(seen)
         else:
             self.known = track(self.known, seen)
         return self.known.copy()
 
     # -- ground truth ----------------------------------------------------------------------
+    def _identify(self, seen: np.ndarray) -> None:
+        """Pair each tracked object with the body it is (for ground truth only)."""
+        from scipy.optimize import linear_sum_assignment
+
+        if seen.shape[0] == 0 or not self.bodies:
+            self.identity = []
+            return
+        p = seen[:, 1:7]
+        centres = np.column_stack([(p[:, 0] + p[:, 1]) / 2, (p[:, 2] + p[:, 3]) / 2])
+        true = np.array([np.asarray(b.pose.p[:2]) for b in self.bodies])
+        cost = np.linalg.norm(centres[:, None, :] - true[None, :, :], axis=2)
+        rows, cols = linear_sum_assignment(cost)
+        identity = [int(i) for i in cost.argmin(axis=1)]  # a split object: its nearest body
+        for r, c in zip(rows, cols):
+            identity[r] = int(c)
+        self.identity = identity
+
+    def tracked_truth(self) -> list[ObjectTruth]:
+        """Ground truth in the order of the tracked objects."""
+        truth = self.truth()
+        return [truth[i] for i in self.identity]
+
     def truth(self) -> list[ObjectTruth]:
         fingers = {self.hand.links["finger-left"], self.hand.links["finger-right"]}
         touching: dict[int, set] = {i: set() for i in range(len(self.components))}

@@ -118,6 +118,20 @@ class TableScene:
             raise ValueError(f"could not place {n} objects apart on the table; try smaller sizes")
         return out
 
+    def check_layout(self, objects: list[ObjectSpec]) -> None:
+        """Raise ValueError (one sentence) if a layout's objects do not stand on this table."""
+        w = self.config.world
+        for i, o in enumerate(objects):
+            x, y = o.position
+            if not (w.table_near <= x <= w.table_far and -w.table_width / 2 <= y <= w.table_width / 2):
+                raise ValueError(f"object {i} at ({x}, {y}) is not on the table "
+                                 f"(x {w.table_near}..{w.table_far}, y {-w.table_width / 2}..{w.table_width / 2})")
+        for i, a in enumerate(objects):
+            for j in range(i + 1, len(objects)):
+                b = objects[j]
+                if math.dist(a.position, b.position) < 0.5 * (min(a.extents[:2]) + min(b.extents[:2])):
+                    raise ValueError(f"objects {i} and {j} overlap")
+
     def build(self, objects: list[ObjectSpec], rng: np.random.Generator) -> TableWorld:
         """A fresh world with these objects (one per episode: a reused scene carries history)."""
         if self._camera is None:
