@@ -6,9 +6,11 @@ Exit codes: 0 success, 1 a runtime or data error (one sentence on stderr, ``erro
 
 from __future__ import annotations
 
+import functools
 import os
 import sys
 import warnings
+from typing import Callable
 
 import typer
 
@@ -22,10 +24,28 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-app.command("scenes")(scenes.scenes)
-app.command("explore")(explore.explore)
-app.command("inspect")(inspect.inspect)
-app.command("demo")(demo.demo)
+
+
+def _guarded(command: Callable) -> Callable:
+    """Known failures become ``error: <one sentence>`` on stderr and exit code 1."""
+
+    @functools.wraps(command)
+    def run(*args, **kwargs):
+        try:
+            return command(*args, **kwargs)
+        except (AffordError, ValueError, KeyError, OSError) as exc:
+            if os.environ.get("AFFORD_DEBUG") == "1":
+                raise
+            message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+            sys.stderr.write(f"error: {message}\n")
+            raise typer.Exit(1) from None
+
+    return run
+
+
+for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
+                        ("inspect", inspect.inspect), ("demo", demo.demo)):
+    app.command(_name)(_guarded(_command))
 
 
 def _quiet_libraries() -> None:
@@ -33,22 +53,15 @@ def _quiet_libraries() -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Console entry point: run the app, turn known failures into exit code 1."""
+    """Console entry point."""
     _quiet_libraries()
-    debug = os.environ.get("AFFORD_DEBUG") == "1"
     try:
-        app(args=argv, standalone_mode=True)
-    except SystemExit:
-        raise
-    except (AffordError, ValueError, KeyError, OSError) as exc:
-        if debug:
-            raise
-        message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
-        sys.stderr.write(f"error: {message}\n")
-        sys.exit(1)
+        app(args=argv)
     except KeyboardInterrupt:
         sys.stderr.write("error: interrupted\n")
         sys.exit(130)
+    except BrokenPipeError:  # a pipeline reader went away: not our error to report
+        sys.exit(1)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -33,7 +33,7 @@ from afford_cli.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
-    "artifact_bytes", "TRUSTED_TYPES",
+    "artifact_bytes", "TRUSTED_TYPES", "dump_estimator", "load_estimator",
 ]
 
 FORMAT = "afford"
@@ -79,6 +79,40 @@ class Artifact:
 
     def parent_ref(self) -> dict[str, str]:
         return {"kind": self.kind, "sha256": self.sha256}
+
+    def estimator(self, name: str, trusted: list[str] | None = None):
+        """Load estimator member ``name`` with skops, refusing any type not trusted."""
+        if name not in self.blobs:
+            raise AffordError(f"{self.source} holds no estimator named {name!r}")
+        return load_estimator(self.blobs[name], f"{self.source}: {name}", trusted)
+
+
+def dump_estimator(estimator) -> bytes:
+    import skops.io as sio
+
+    return sio.dumps(estimator)
+
+
+def load_estimator(blob: bytes, where: str, trusted: list[str] | None = None):
+    """skops.io load that refuses, in one sentence, any type outside the trusted list.
+
+    skops rebuilds objects from a declarative description and only instantiates types it
+    is told to trust, so opening a model file never runs code from the file.
+    """
+    import skops.io as sio
+
+    allowed = set(TRUSTED_TYPES if trusted is None else trusted)
+    try:
+        untrusted = sio.get_untrusted_types(data=blob)
+    except Exception:
+        raise AffordError(f"{where} is not a readable estimator") from None
+    refused = [t for t in untrusted if t not in allowed]
+    if refused:
+        raise AffordError(f"{where} holds the untrusted type {refused[0]}; refusing to load it")
+    try:
+        return sio.loads(blob, trusted=untrusted)
+    except Exception as exc:
+        raise AffordError(f"{where} cannot be loaded ({type(exc).__name__})") from None
 
 
 def artifact_bytes(kind: str, arrays: dict[str, np.ndarray], meta: dict[str, Any], *,

@@ -90,24 +90,26 @@ class Detection:
 def _components(candidate: np.ndarray, ranges: np.ndarray, jump: float) -> np.ndarray:
     """Label image of 4-connected components whose neighbouring ranges differ < jump."""
     h, w = candidate.shape
-    idx = np.arange(h * w).reshape(h, w)
+    flat = np.flatnonzero(candidate)
+    node = np.full(h * w, -1, dtype=np.int64)
+    node[flat] = np.arange(flat.size)
+    r = ranges.ravel()
     rows, cols = [], []
-    for a, b, ra, rb in (
-        (idx[:, :-1], idx[:, 1:], ranges[:, :-1], ranges[:, 1:]),
-        (idx[:-1, :], idx[1:, :], ranges[:-1, :], ranges[1:, :]),
-    ):
-        ca = candidate[:, :-1] if a.shape[1] == w - 1 else candidate[:-1, :]
-        cb = candidate[:, 1:] if a.shape[1] == w - 1 else candidate[1:, :]
-        with np.errstate(invalid="ignore"):
-            ok = ca & cb & (np.abs(ra - rb) < jump)
-        rows.append(a[ok])
-        cols.append(b[ok])
-    r = np.concatenate(rows)
-    c = np.concatenate(cols)
-    graph = coo_matrix((np.ones(r.size, dtype=np.int8), (r, c)), shape=(h * w, h * w))
+    for step, valid in ((1, (flat % w) < w - 1), (w, flat < (h - 1) * w)):
+        a = flat[valid]
+        b = a + step
+        ok = candidate.ravel()[b]
+        a, b = a[ok], b[ok]
+        ok = np.abs(r[a] - r[b]) < jump
+        rows.append(node[a[ok]])
+        cols.append(node[b[ok]])
+    i = np.concatenate(rows)
+    j = np.concatenate(cols)
+    graph = coo_matrix((np.ones(i.size, dtype=np.int8), (i, j)), shape=(flat.size, flat.size))
     _, comp = connected_components(graph, directed=False)
-    labels = np.where(candidate.ravel(), comp + 1, 0).reshape(h, w)
-    return labels
+    labels = np.zeros(h * w, dtype=np.int64)
+    labels[flat] = comp + 1
+    return labels.reshape(h, w)
 
 
 def _masked_median(values: np.ndarray, mask: np.ndarray, size: int) -> np.ndarray:

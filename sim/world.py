@@ -48,7 +48,7 @@ class TableConfig:
         return RegionOfInterest(
             x=(self.table_near, self.table_far),
             y=(-self.table_width / 2, self.table_width / 2),
-            z=(self.table_top + 0.008, self.table_top + 0.80),
+            z=(self.table_top + 0.008, self.table_top + 0.60),
         )
 
 
@@ -102,6 +102,8 @@ class TableWorld:
             # so that rolling objects slow down a little as real ones do.
             comp.set_angular_damping(c.rolling_damping)
         self.camera = camera or RangeCamera(c.camera)
+        v, t, p, q = self._table_mesh
+        self.camera.set_static([MeshInstance(v, t, p, q)], key=(half_table, tuple(table_pose.p)))
         self.holding = False
         self.contact = False
         self.steps = 0
@@ -179,8 +181,8 @@ class TableWorld:
 
     # -- perception ------------------------------------------------------------------------
     def meshes(self) -> list[MeshInstance]:
-        v, t, p, q = self._table_mesh
-        out = [MeshInstance(v, t, p, q)]
+        """The moving bodies as the camera sees them (the table is the camera's static part)."""
+        out = []
         for spec, body in zip(self.specs, self.bodies):
             pose = body.pose
             v, t = object_mesh(spec)

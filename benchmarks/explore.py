@@ -1,0 +1,100 @@
+"""Exploration speed: interactions per second with 1 and 2 workers, and where the time goes.
+
+    python benchmarks/explore.py [--interactions N] [--out benchmarks/results/explore.json]
+
+Prints one JSON object (and writes it to --out). The breakdown times one worker's
+episodes in this process by wrapping the four stages: world build, ray casting (Open3D),
+physics (PhysX steps, including contact queries) and features (detection, normals,
+histograms, tracking).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import features.objects as fobj  # noqa: E402
+import sim.camera as cam  # noqa: E402
+import sim.world as world  # noqa: E402
+from sim.explore import explore, run_episode  # noqa: E402
+from sim.registry import get_scene  # noqa: E402
+
+
+def throughput(scene, n: int, workers: int, seed: int) -> dict:
+    explore(scene, interactions=min(n, 20), seed=seed + 999, workers=workers)  # start the workers' imports
+    start = time.perf_counter()
+    data = explore(scene, interactions=n, seed=seed, workers=workers)
+    seconds = time.perf_counter() - start
+    return {"workers": workers, "interactions": len(data), "seconds": round(seconds, 3),
+            "interactions_per_second": round(len(data) / seconds, 1)}
+
+
+def breakdown(scene, episodes: int, seed: int) -> dict:
+    totals = {"world_build": 0.0, "ray_casting": 0.0, "physics": 0.0, "features": 0.0}
+
+    def timed(key, fn):
+        def wrapper(*a, **k):
+            t = time.perf_counter()
+            try:
+                return fn(*a, **k)
+            finally:
+                totals[key] += time.perf_counter() - t
+        return wrapper
+
+    saved = (world.TableWorld.__init__, cam.RangeCamera.capture, world.TableWorld.step, world.perceive, world.track)
+    world.TableWorld.__init__ = timed("world_build", saved[0])
+    cam.RangeCamera.capture = timed("ray_casting", saved[1])
+    world.TableWorld.step = timed("physics", saved[2])
+    world.perceive = timed("features", saved[3])
+    world.track = timed("features", saved[4])
+    try:
+        start = time.perf_counter()
+        rows = sum(len(run_episode(scene, seed, e)) for e in range(episodes))
+        total = time.perf_counter() - start
+    finally:
+        (world.TableWorld.__init__, cam.RangeCamera.capture, world.TableWorld.step, world.perceive, world.track) = saved
+    # world build includes the initial settle of a held object (physics), counted once each
+    out = {k: round(1000 * v / rows, 2) for k, v in totals.items()}
+    out["other"] = round(1000 * total / rows - sum(out.values()), 2)
+    return {"ms_per_interaction": out, "interactions": rows, "seconds": round(total, 3)}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--interactions", type=int, default=1000)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "explore.json"))
+    args = ap.parse_args()
+    scene = get_scene("table")()
+    result = {
+        "benchmark": "explore",
+        "machine": {"python": platform.python_version(), "cpus": __import__("os").cpu_count(),
+                    "platform": platform.platform()},
+        "throughput": [throughput(scene, args.interactions, w, args.seed) for w in (1, 2)],
+        "breakdown_one_worker": breakdown(scene, episodes=max(20, args.interactions // 10), seed=args.seed),
+        "features_alone_ms": None,
+    }
+    # perception alone, on a typical range image
+    rng = np.random.default_rng(0)
+    w = scene.build([scene.sample_object(rng)], rng)
+    image = w.camera.capture(w.meshes(), rng)
+    t = time.perf_counter()
+    for _ in range(50):
+        fobj.perceive(image, w.config.roi())
+    result["features_alone_ms"] = round(1000 * (time.perf_counter() - t) / 50, 2)
+    text = json.dumps(result, indent=1)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(text + "\n")
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
