@@ -158,7 +158,10 @@ def detect_objects(
     list of Detection, ordered by their first pixel in raster order.
     """
     ranges = image.ranges
-    candidate = np.isfinite(ranges) & roi.contains(image.points())
+    candidate = np.isfinite(ranges)
+    hit = np.flatnonzero(candidate)
+    points = image.origin + ranges.ravel()[hit, None] * image.directions.reshape(-1, 3)[hit]
+    candidate.ravel()[hit] = roi.contains(points)
     if image.own_body is not None:
         candidate &= ~image.own_body
     if not candidate.any():

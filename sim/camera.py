@@ -131,15 +131,17 @@ class RangeCamera:
         ranges = self._static_ranges.copy()
         own = np.zeros(ranges.size, dtype=bool)
         if meshes:
-            boxes = [m.world_vertices() for m in meshes]
-            rays = np.unique(np.concatenate([self._rays_through(b.min(axis=0) - 0.005, b.max(axis=0) + 0.005)
-                                             for b in boxes]))
+            wanted = np.zeros(ranges.size, dtype=bool)
+            for m in meshes:
+                b = m.world_vertices()
+                wanted[self._rays_through(b.min(axis=0) - 0.005, b.max(axis=0) + 0.005)] = True
+            rays = np.flatnonzero(wanted)
             if rays.size:
                 t, ids, own_ids = self._cast(meshes, rays)
                 nearer = t < ranges[rays]
                 ranges[rays[nearer]] = t[nearer]
                 if own_ids:
                     own[rays[nearer]] = np.isin(ids[nearer], own_ids)
-        noise = rng.normal(0.0, self.config.noise, size=ranges.size)
-        ranges = np.where(np.isfinite(ranges), ranges + noise, np.inf).reshape(shape)
+        ranges += self.config.noise * rng.standard_normal(ranges.size, dtype=np.float32)  # inf stays inf
+        ranges = ranges.reshape(shape)
         return RangeImage(ranges=ranges, directions=self.directions, origin=self.origin, own_body=own.reshape(shape))

@@ -80,7 +80,7 @@ def render_outcome_table(console, outcomes: dict) -> None:
     from features import OUTCOMES
 
     ot = Table(title="what physically happened (ground truth, never used to learn)")
-    ot.add_column("behaviour")
+    ot.add_column("behaviour", no_wrap=True)
     ot.add_column("shape", no_wrap=True, min_width=14)
     for label in OUTCOMES:
         ot.add_column(label, justify="right")
