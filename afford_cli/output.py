@@ -8,6 +8,7 @@ the report (human or JSON) goes to stderr too.
 from __future__ import annotations
 
 import json
+import os
 import sys
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator
@@ -24,6 +25,9 @@ class Output:
         self.stdout_busy = stdout_busy
         self.err = Console(stderr=True, highlight=False)
         self.report = Console(stderr=stdout_busy, highlight=False, soft_wrap=False)
+        if not self.report.is_terminal and "COLUMNS" not in os.environ:
+            # Reports piped to a file or another program are not squeezed into 80 columns.
+            self.report.width = 120
 
     def result(self, data: dict[str, Any], render: Callable[[Console], None]) -> None:
         """Emit the command's result: JSON, or the human rendering."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from rich import box
 from rich.table import Table
 
 from afford_cli.artifacts import Artifact, read_artifact
@@ -79,11 +80,11 @@ def render_outcome_table(console, outcomes: dict) -> None:
     """``{behaviour: {shape: {label: count}}}`` as one table."""
     from features import OUTCOMES
 
-    ot = Table(title="what physically happened (ground truth, never used to learn)")
+    ot = Table(title="what physically happened (ground truth, never used to learn)", box=box.SIMPLE_HEAD)
     ot.add_column("behaviour", no_wrap=True)
     ot.add_column("shape", no_wrap=True, min_width=14)
     for label in OUTCOMES:
-        ot.add_column(label, justify="right")
+        ot.add_column(label, justify="right", no_wrap=True)
     for behavior, shapes in outcomes.items():
         for shape, counts in shapes.items():
             ot.add_row(behavior, shape, *[str(counts.get(label, 0)) for label in OUTCOMES])
