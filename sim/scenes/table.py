@@ -103,20 +103,18 @@ class TableScene:
         return ObjectSpec(shape, size, (round(x, 4), round(y, 4)), round(yaw, 3))
 
     def sample_objects(self, rng: np.random.Generator, n: int = 1, min_gap: float = 0.05,
-                       tries: int = 200) -> list[ObjectSpec]:
-        """``n`` random objects whose footprints keep ``min_gap`` apart (where possible)."""
-        out: list[ObjectSpec] = []
-        for _ in range(tries):
-            if len(out) == n:
-                break
-            cand = self.sample_object(rng)
-            ok = all(math.dist(cand.position, o.position) >= cand.footprint_radius + o.footprint_radius + min_gap
-                     for o in out)
-            if ok:
-                out.append(cand)
-        if len(out) < n:
-            raise ValueError(f"could not place {n} objects apart on the table; try smaller sizes")
-        return out
+                       restarts: int = 50, tries: int = 50) -> list[ObjectSpec]:
+        """``n`` random objects whose footprints keep ``min_gap`` apart."""
+        for _ in range(restarts):
+            out: list[ObjectSpec] = []
+            for _ in range(tries):
+                cand = self.sample_object(rng)
+                if all(math.dist(cand.position, o.position) >= cand.footprint_radius + o.footprint_radius + min_gap
+                       for o in out):
+                    out.append(cand)
+                    if len(out) == n:
+                        return out
+        raise ValueError(f"could not place {n} objects apart on the table; try fewer or smaller objects")
 
     def check_layout(self, objects: list[ObjectSpec]) -> None:
         """Raise ValueError (one sentence) if a layout's objects do not stand on this table."""
