@@ -123,26 +123,23 @@ class TableWorld:
                 self.contact = self._hand_touches_object()
         self.steps += n
 
-    def _hand_touches_object(self) -> bool:
-        hand = set(self.hand.body_links)
+    def _touches_object(self, links) -> bool:
+        """Does any of ``links`` press on an object (a contact with a non-zero impulse)?"""
+        links = set(links)
         objs = set(self.components)
         for contact in self.scene.get_contacts():
             a, b = contact.bodies
-            if (a in hand and b in objs) or (b in hand and a in objs):
+            if (a in links and b in objs) or (b in links and a in objs):
                 if any(np.linalg.norm(p.impulse) > 0 for p in contact.points):
                     return True
         return False
 
+    def _hand_touches_object(self) -> bool:
+        return self._touches_object(self.hand.body_links)
+
     def palm_touches_object(self) -> bool:
         """The hand's touch sense: is the palm pressing on an object?"""
-        palm = self.hand.links["palm"]
-        objs = set(self.components)
-        for contact in self.scene.get_contacts():
-            a, b = contact.bodies
-            if (a is palm and b in objs) or (b is palm and a in objs):
-                if any(np.linalg.norm(p.impulse) > 0 for p in contact.points):
-                    return True
-        return False
+        return self._touches_object([self.hand.links["palm"]])
 
     def settle(self) -> None:
         """Step until every object rests, has fallen below the table, or time runs out."""
