@@ -1,0 +1,112 @@
+"""The per-behaviour learning steps of chapter 8, run on an :class:`Interactions` set.
+
+Each step is what one command runs (``cluster``, ``select-features``, ``train``), and
+each works behaviour by behaviour, as the thesis does:
+
+1. :func:`discover_effects`: effect categories of ``after - before``;
+2. :func:`rank_features`: which object features tell those categories apart;
+3. :func:`train_predictors`: the relevant features (plus the behaviour's parameters alpha)
+   to calibrated probabilities over the categories.
+
+Every behaviour gets its own random state, derived from one seed and the behaviour's index,
+so results do not depend on the order behaviours are processed in.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from features import Interactions
+from learn.effects import EffectCategories
+from learn.predictors import AffordancePredictor
+from learn.relevance import FeatureRelevance, feature_groups
+
+__all__ = [
+    "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",
+    "behaviour_seed",
+]
+
+#: Fewest interactions of one behaviour worth learning from.
+MIN_ROWS = 30
+
+
+def behaviour_seed(seed: int, b: int) -> int:
+    return int(np.random.SeedSequence(entropy=seed, spawn_key=(b,)).generate_state(1)[0])
+
+
+def behaviour_rows(data: Interactions, b: int, labels: np.ndarray | None = None) -> np.ndarray:
+    """Rows of behaviour ``b`` (and, given ``labels``, only those with a kept category)."""
+    mask = data.behavior == b
+    if labels is not None:
+        mask &= labels >= 0
+    return np.flatnonzero(mask)
+
+
+def n_params(data: Interactions, b: int) -> int:
+    return len(data.behaviors[b].get("parameters", []))
+
+
+def predictor_inputs(before: np.ndarray, params: np.ndarray, selected: np.ndarray, k: int) -> np.ndarray:
+    """The predictor's input: selected object features, then the behaviour's k parameters."""
+    return np.hstack([before[:, selected], params[:, :k]])
+
+
+def _check_rows(data: Interactions, b: int, rows: np.ndarray, what: str) -> None:
+    name = data.behavior_names[b]
+    if rows.size == 0:
+        raise ValueError(f"the data hold no interactions of behaviour {name!r}; explore more before {what}")
+    if rows.size < MIN_ROWS:
+        raise ValueError(f"behaviour {name!r} has only {rows.size} usable interactions; {what} needs at least {MIN_ROWS}")
+
+
+def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max: int = 5, k: int | None = None,
+                     prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0) -> tuple[dict, np.ndarray]:
+    """Effect categories per behaviour; returns ``({name: EffectCategories}, labels)``.
+
+    ``labels`` has one entry per row: the row's category within its behaviour, or -1 for a
+    row whose category was pruned.
+    """
+    labels = np.full(len(data), -1, dtype=np.int16)
+    models = {}
+    effects = data.effects
+    for b, name in enumerate(data.behavior_names):
+        rows = behaviour_rows(data, b)
+        _check_rows(data, b, rows, "clustering")
+        X = np.hstack([data.before[rows], data.params[rows, : n_params(data, b)]])
+        ec = EffectCategories(schema=tuple(data.schema.channels), method=method, k_max=k_max, k=k, prune=prune,
+                              min_fraction=min_fraction, random_state=behaviour_seed(seed, b))
+        ec.fit(effects[rows], X)
+        labels[rows] = ec.labels_
+        models[name] = ec
+    return models, labels
+
+
+def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "relieff", top: int | None = None,
+                  seed: int = 0, group_channels: bool = False) -> dict:
+    """Feature relevance per behaviour (on rows with a kept category); ``{name: FeatureRelevance}``."""
+    out = {}
+    groups = feature_groups(data.schema) if group_channels else None
+    for b, name in enumerate(data.behavior_names):
+        rows = behaviour_rows(data, b, labels)
+        _check_rows(data, b, rows, "feature selection")
+        y = labels[rows]
+        if np.unique(y).size < 2:
+            raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to tell apart")
+        fr = FeatureRelevance(method=method, top=top, feature_groups=groups, random_state=behaviour_seed(seed, b))
+        out[name] = fr.fit(data.before[rows], y)
+    return out
+
+
+def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str, np.ndarray], *,
+                     kernel: str = "rbf", seed: int = 0, n_jobs: int | None = None) -> dict:
+    """One calibrated predictor per behaviour; ``{name: AffordancePredictor}``."""
+    out = {}
+    for b, name in enumerate(data.behavior_names):
+        rows = behaviour_rows(data, b, labels)
+        _check_rows(data, b, rows, "training")
+        y = labels[rows]
+        if np.unique(y).size < 2:
+            raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to predict")
+        X = predictor_inputs(data.before[rows], data.params[rows], selected[name], n_params(data, b))
+        out[name] = AffordancePredictor(kernel=kernel, n_jobs=n_jobs, random_state=behaviour_seed(seed, b)).fit(X, y)
+    return out

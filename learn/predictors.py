@@ -1,0 +1,265 @@
+"""Affordance predictors: P(effect category | object features, behaviour parameters).
+
+The thesis's ``Predictor^b(f_relevant, alpha) -> E`` (3.3.3) is an SVM per behaviour with an
+RBF kernel whose C and gamma come from a cross-validated grid (8.5.3). afford adds
+calibrated probabilities over the categories (DESIGN.md 7.3), which planning multiplies
+along a plan. ``SVC(probability=True)`` is deprecated in scikit-learn 1.9, so the SVM's
+decision values are calibrated by :class:`~sklearn.calibration.CalibratedClassifierCV`
+(by default one sigmoid per category, one-versus-rest, renormalised), on the same folds
+the grid search used.
+
+Categories with very few members
+    Folds are stratified, so a category with ``2 <= count < cv`` members sits in ``count``
+    different test folds and in every training fold; the folds where it is absent from the
+    test part calibrate it on zero positives, which drives its probability towards Platt's
+    prior ``1 / (n_negatives + 2)`` (or 0 for isotonic). A category with a *single* member
+    is never put in a test fold (a :class:`~sklearn.model_selection.PredefinedSplit` with
+    ``-1``): every fold's SVM knows it, no fold can score it, and its probability stays
+    near zero. Nothing crashes and no category disappears from ``classes_``.
+
+Saved models are loaded by :func:`skops.io.load` with :data:`TRUSTED_TYPES`, the
+scikit-learn types a fitted predictor holds that skops does not trust by default.
+"""
+
+from __future__ import annotations
+
+import numbers
+import warnings
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.calibration import CalibratedClassifierCV
+from sklearn.model_selection import GridSearchCV, PredefinedSplit, StratifiedKFold
+from sklearn.pipeline import Pipeline
+from sklearn.preprocessing import StandardScaler
+from sklearn.svm import SVC, LinearSVC
+from sklearn.utils import check_random_state
+from sklearn.utils._param_validation import Interval, StrOptions
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from learn.xmeans import _check_finite
+
+__all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
+
+#: Types in a fitted :class:`AffordancePredictor` that ``skops.io`` does not trust by
+#: default; pass them to ``skops.io.load(..., trusted=TRUSTED_TYPES)``. A test dumps fitted
+#: predictors (every calibration method) and checks that ``get_untrusted_types`` reports
+#: exactly these, together.
+TRUSTED_TYPES: list[str] = [
+    "learn.predictors.AffordancePredictor",
+    "sklearn.calibration._CalibratedClassifier",
+    "sklearn.calibration._SigmoidCalibration",
+    "sklearn.calibration._TemperatureScaling",
+    "sklearn.model_selection._split.PredefinedSplit",
+]
+
+#: Default gamma grid, as multiples of ``1 / n_features`` (the "scale" value on
+#: standardised inputs).
+_GAMMA_FACTORS = (0.1, 1.0, 10.0)
+
+
+class AffordancePredictor(ClassifierMixin, BaseEstimator):
+    """Calibrated SVM predicting a behaviour's effect category from object features.
+
+    ``Pipeline(StandardScaler, SVC)`` with C (and gamma) chosen by a stratified,
+    cross-validated grid search on accuracy (the smoothest setting within one standard
+    error of the best), then ``CalibratedClassifierCV`` on the same folds (one SVM per
+    fold, probabilities averaged).
+
+    There is no ``class_weight``: calibration maps the decision values back to the observed
+    category frequencies, so re-weighting the SVM would not change the probabilities'
+    meaning, only blur them.
+
+    Parameters
+    ----------
+    kernel : {"rbf", "linear"}, default="rbf"
+        ``"rbf"``: :class:`~sklearn.svm.SVC` (libsvm, as the thesis). ``"linear"``:
+        :class:`~sklearn.svm.LinearSVC` solved in the primal (liblinear, squared hinge),
+        which takes milliseconds where libsvm's linear kernel takes seconds at C = 100.
+    C_grid : tuple of float, default=(0.1, 1.0, 10.0, 100.0)
+    gamma_grid : tuple of float or None, default=None
+        RBF widths to try. None: ``(0.1, 1, 10) / n_features``. Ignored for ``"linear"``.
+    cv : int, default=3
+        Folds of the grid search and of the calibration.
+    calibration : {"sigmoid", "isotonic", "temperature"}, default="sigmoid"
+        Platt scaling per category (one-versus-rest, renormalised) suits a few hundred rows
+        per category and never answers exactly 0. Isotonic regression is more flexible but
+        needs more rows and can answer 0 (an infinite log loss). Temperature scaling fits
+        one softmax temperature for all categories.
+    n_jobs : int or None, default=None
+        Grid-search candidates and calibration folds fitted in parallel.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the folds; the fit is otherwise deterministic.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+        The categories seen in ``y``, sorted; columns of :meth:`predict_proba`.
+    calibrated_ : CalibratedClassifierCV
+        The fitted model (its own classes are ``0 .. n_classes - 1``).
+    cv_report_ : dict
+        ``best_params`` (C, gamma), ``cv_accuracy`` and ``cv_accuracy_std`` of the chosen
+        setting, ``grid`` (every setting with its accuracy), ``n_splits``,
+        ``class_counts`` and ``singleton_classes`` (categories never used as test rows).
+    n_features_in_ : int
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from learn import AffordancePredictor
+    >>> rng = np.random.default_rng(0)
+    >>> X = rng.normal(size=(200, 2))
+    >>> y = (X[:, 0] > 0).astype(int)
+    >>> model = AffordancePredictor(random_state=0).fit(X, y)
+    >>> model.predict_proba([[2.0, 0.0]]).round(1)
+    array([[0., 1.]])
+    """
+
+    _parameter_constraints = {
+        "kernel": [StrOptions({"rbf", "linear"})],
+        "C_grid": ["array-like"],
+        "gamma_grid": ["array-like", None],
+        "cv": [Interval(numbers.Integral, 2, None, closed="left")],
+        "calibration": [StrOptions({"sigmoid", "isotonic", "temperature"})],
+        "n_jobs": [numbers.Integral, None],
+        "random_state": ["random_state"],
+    }
+
+    def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0), gamma_grid=None, cv=3,
+                 calibration="sigmoid", n_jobs=None, random_state=None):
+        self.kernel = kernel
+        self.C_grid = C_grid
+        self.gamma_grid = gamma_grid
+        self.cv = cv
+        self.calibration = calibration
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+
+    def _folds(self, y_idx: np.ndarray) -> PredefinedSplit:
+        """Stratified folds; members of single-member categories stay in every training part."""
+        counts = np.bincount(y_idx)
+        singleton = counts[y_idx] == 1
+        rows = np.flatnonzero(~singleton)
+        if rows.size < self.cv:
+            raise ValueError(
+                f"y has {y_idx.size} rows, too few to cross-validate with cv={self.cv}: at least "
+                f"{self.cv} rows must belong to categories with two or more members."
+            )
+        seed = check_random_state(self.random_state).randint(np.iinfo(np.int32).max)
+        test_fold = np.full(y_idx.size, -1)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", message="The least populated class")
+            splitter = StratifiedKFold(self.cv, shuffle=True, random_state=seed)
+            for i, (_, test) in enumerate(splitter.split(np.zeros(rows.size), y_idx[rows])):
+                test_fold[rows[test]] = i
+        return PredefinedSplit(test_fold)
+
+    @staticmethod
+    def _simplest_good(results) -> int:
+        """Index of the smoothest setting within one standard error of the best accuracy.
+
+        Accuracy is flat over much of the grid on noisy data, and the most accurate
+        setting is then often a wiggly one (large gamma, large C) whose decision values
+        calibrate poorly. The one-standard-error rule takes the smallest gamma, then the
+        smallest C, among the settings the folds cannot tell from the best.
+        """
+        mean = np.asarray(results["mean_test_score"])
+        std = np.asarray(results["std_test_score"])
+        top = int(np.argmax(mean))
+        n_splits = sum(1 for k in results if k.startswith("split") and k.endswith("_test_score"))
+        good = np.flatnonzero(mean >= mean[top] - std[top] / np.sqrt(max(n_splits, 1)))
+        key = [(p.get("svc__gamma", 0.0), p["svc__C"]) for p in results["params"]]
+        return int(min(good, key=lambda i: key[i]))
+
+    def fit(self, X, y):
+        """Choose C (and gamma), then fit the calibrated SVM.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+            Relevant object features with the behaviour parameters alpha appended.
+        y : array-like of shape (n_samples,)
+            Effect category of each row (no pruned rows).
+
+        Returns
+        -------
+        self : AffordancePredictor
+        """
+        self._validate_params()
+        X, y = validate_data(self, X, y, dtype=np.float64, ensure_all_finite=False)
+        _check_finite(X)
+        check_classification_targets(y)
+        self.classes_, y_idx = np.unique(y, return_inverse=True)
+        if self.classes_.size < 2:
+            raise ValueError(
+                "AffordancePredictor needs at least two effect categories to learn from, "
+                f"but y holds only one class ({self.classes_[0]!r})."
+            )
+        folds = self._folds(y_idx)
+
+        if self.kernel == "rbf":
+            svc = SVC(kernel="rbf")
+        else:  # liblinear's primal solver: seconds faster than libsvm's linear kernel at large C
+            svc = LinearSVC(dual=False)
+        base = Pipeline([("scale", StandardScaler()), ("svc", svc)])
+        grid = {"svc__C": [float(c) for c in self.C_grid]}
+        if self.kernel == "rbf":
+            gammas = self.gamma_grid
+            if gammas is None:
+                gammas = [f / X.shape[1] for f in _GAMMA_FACTORS]
+            grid["svc__gamma"] = [float(g) for g in gammas]
+        search = GridSearchCV(base, grid, scoring="accuracy", cv=folds, refit=False, n_jobs=self.n_jobs,
+                              error_score="raise")
+        search.fit(X, y_idx)
+        params = search.cv_results_["params"]
+        best = self._simplest_good(search.cv_results_)
+        model = clone(base).set_params(**params[best])
+        self.calibrated_ = CalibratedClassifierCV(model, method=self.calibration, cv=folds, n_jobs=self.n_jobs)
+        self.calibrated_.fit(X, y_idx)
+
+        counts = np.bincount(y_idx)
+        self.cv_report_ = {
+            "best_params": {k.removeprefix("svc__"): float(v) for k, v in params[best].items()},
+            "cv_accuracy": float(search.cv_results_["mean_test_score"][best]),
+            "cv_accuracy_std": float(search.cv_results_["std_test_score"][best]),
+            "grid": [
+                {**{k.removeprefix("svc__"): float(v) for k, v in p.items()}, "accuracy": float(a)}
+                for p, a in zip(params, search.cv_results_["mean_test_score"])
+            ],
+            "n_splits": int(self.cv),
+            "class_counts": {str(c): int(n) for c, n in zip(self.classes_.tolist(), counts)},
+            "singleton_classes": [str(c) for c, n in zip(self.classes_.tolist(), counts) if n == 1],
+        }
+        return self
+
+    def predict_proba(self, X):
+        """Calibrated probability of each category.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+
+        Returns
+        -------
+        proba : ndarray of shape (n_samples, n_classes)
+            Columns follow ``classes_``; rows sum to 1.
+        """
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
+        _check_finite(X)
+        return self.calibrated_.predict_proba(X)
+
+    def predict(self, X):
+        """Most probable category.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+
+        Returns
+        -------
+        y : ndarray of shape (n_samples,)
+        """
+        proba = self.predict_proba(X)
+        return self.classes_[np.argmax(proba, axis=1)]

@@ -1,0 +1,557 @@
+"""Relevant features: which object features tell a behaviour's effect categories apart.
+
+Three methods from the thesis:
+
+ReliefF (chapter 5, Algorithm 3)
+    A filter: ``m`` random interactions; for each, its ``k`` nearest hits (same category)
+    and, per other category, ``k`` nearest misses; a feature gains weight when it differs
+    on misses and loses it when it differs on hits. Features are min-max normalised and
+    distances are Manhattan (sum of normalised differences), as in Kononenko's ReliefF;
+    misses of each class are weighted by that class's prior, ``P(C) / (1 - P(class))``.
+Forward selection (the thesis's ``sequentialfs``, chapter 5.7)
+    A wrapper: start from no feature and add the one whose addition gives the best
+    cross-validated accuracy, while the accuracy rises by more than ``tol``.
+Backward elimination (the "Schemata search" of chapter 8.5.3)
+    A wrapper: start from all features and remove the one (or the group: the thesis
+    treated each normal-angle histogram as one unit) whose removal hurts cross-validated
+    accuracy least, while the accuracy stays within ``tol`` of the best seen.
+
+The wrappers use one set of stratified folds for every candidate, so candidates are
+compared on the same data. Their default classifier is a 10-nearest-neighbour vote on
+standardised features: it is nonlinear (reachability and graspability are thresholds and
+bands), needs no tuning, and costs milliseconds per fold, where the thesis's SVMs would make
+the hundreds of candidate fits of a wrapper take minutes. Pass ``estimator=`` to change it.
+"""
+
+from __future__ import annotations
+
+import numbers
+import re
+import warnings
+
+import numpy as np
+from joblib import Parallel, delayed
+from scipy.spatial.distance import cdist
+from sklearn.base import BaseEstimator, clone
+from sklearn.model_selection import StratifiedKFold
+from sklearn.utils import check_random_state
+from sklearn.utils._param_validation import Interval, StrOptions
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_array, check_is_fitted, validate_data
+
+from features.schema import FeatureSchema
+from learn.xmeans import _check_finite
+
+__all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "relieff"]
+
+# Rows of sampled instances whose distances to all rows are computed at once (memory bound).
+_CHUNK = 256
+
+
+def _check_Xy(X, y, min_rows: int = 2):
+    X = check_array(X, dtype=np.float64, ensure_all_finite=False)
+    _check_finite(X)
+    y = np.asarray(y)
+    if y.ndim != 1 or y.shape[0] != X.shape[0]:
+        raise ValueError(f"y must be one label per row of X: X has {X.shape[0]} rows, y has shape {y.shape}.")
+    check_classification_targets(y)
+    classes, y_idx = np.unique(y, return_inverse=True)
+    if classes.size < 2:
+        raise ValueError(f"feature relevance needs at least two effect categories, but y holds only one class ({classes[0]!r}).")
+    if X.shape[0] < min_rows:
+        raise ValueError(f"X has {X.shape[0]} rows, too few to estimate feature relevance (need at least {min_rows}).")
+    return X, y, classes, y_idx
+
+
+def feature_groups(schema) -> np.ndarray:
+    """Group label per feature: features ``<prefix>_<number>`` of one channel form one group.
+
+    This makes each 18-bin normal-angle histogram (``elevation_00`` ... ``elevation_17``)
+    one unit for the wrappers, as in the thesis's Schemata search; every other feature
+    (``visibility``, ``x_min``, ...) is a group of its own.
+
+    Parameters
+    ----------
+    schema : FeatureSchema or sequence of str
+        A schema, or feature names (each then counts as its own channel).
+
+    Returns
+    -------
+    groups : ndarray of shape (n_features,)
+        Integer group labels, numbered in order of first appearance.
+    """
+    if isinstance(schema, FeatureSchema):
+        names, channels = schema.names, schema.channels
+    else:
+        names = tuple(str(n) for n in schema)
+        channels = names
+    keys = []
+    for name, channel in zip(names, channels):
+        m = re.fullmatch(r"(.+)_\d+", name)
+        keys.append((channel, m.group(1)) if m else (channel, name, "single"))
+    index = {k: i for i, k in enumerate(dict.fromkeys(keys))}
+    return np.array([index[k] for k in keys], dtype=int)
+
+
+def relieff(X, y, n_samples=1000, n_neighbors=10, random_state=None) -> np.ndarray:
+    """ReliefF feature weights (Algorithm 3), vectorised.
+
+    Parameters
+    ----------
+    X : array-like of shape (n_rows, n_features)
+    y : array-like of shape (n_rows,)
+        Effect category of each row.
+    n_samples : int, default=1000
+        ``m``, the number of sampled rows (1000 in the thesis); all rows when there are
+        fewer. Neighbours are searched among all rows.
+    n_neighbors : int, default=10
+        ``k`` hits and ``k`` misses per other class (10 in the thesis); fewer when a class
+        has fewer members.
+    random_state : int, RandomState instance or None, default=None
+
+    Returns
+    -------
+    weights : ndarray of shape (n_features,)
+        Higher is more relevant; about 0 for noise, at most 1. Constant features get 0.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> X = rng.random((300, 4))
+    >>> y = (X[:, 2] > 0.5).astype(int)
+    >>> int(np.argmax(relieff(X, y, random_state=0)))
+    2
+    """
+    X, y, classes, y_idx = _check_Xy(X, y)
+    if n_samples < 1 or n_neighbors < 1:
+        raise ValueError("n_samples and n_neighbors must be at least 1.")
+    rng = check_random_state(random_state)
+    n, d = X.shape
+    span = X.max(axis=0) - X.min(axis=0)
+    Xn = (X - X.min(axis=0)) / np.where(span > 0, span, 1.0)
+    prior = np.bincount(y_idx) / n
+    members = [np.flatnonzero(y_idx == c) for c in range(classes.size)]
+    m = min(n_samples, n)
+    sample = np.sort(rng.choice(n, m, replace=False))
+    k = n_neighbors
+    weights = np.zeros(d)
+    for start in range(0, m, _CHUNK):
+        rows = sample[start : start + _CHUNK]
+        R = Xn[rows]
+        D = cdist(R, Xn, metric="cityblock")
+        D[np.arange(rows.size), rows] = np.inf  # a row is not its own neighbour
+        own = y_idx[rows]
+        for c, idx in enumerate(members):
+            Dc = D[:, idx]
+            kc = min(k, idx.size)
+            nn = np.argpartition(Dc, kc - 1, axis=1)[:, :kc] if kc < idx.size else np.tile(np.arange(idx.size), (rows.size, 1))
+            valid = np.isfinite(np.take_along_axis(Dc, nn, axis=1))  # drops the row itself
+            diff = np.abs(Xn[idx[nn]] - R[:, None, :])  # (rows, kc, d)
+            count = valid.sum(axis=1)
+            mean_diff = (diff * valid[:, :, None]).sum(axis=1) / np.maximum(count, 1)[:, None]
+            hit = own == c
+            coef = np.where(hit, -1.0, prior[c] / (1.0 - prior[own]))
+            coef[count == 0] = 0.0
+            weights += (coef[:, None] * mean_diff).sum(axis=0)
+    return weights / m
+
+
+def _units(groups, d: int) -> list[np.ndarray]:
+    if groups is None:
+        return [np.array([j]) for j in range(d)]
+    groups = np.asarray(groups)
+    if groups.shape != (d,):
+        raise ValueError(f"feature groups must give one group per feature: X has {d} features, groups has shape {groups.shape}.")
+    return [np.flatnonzero(groups == g) for g in dict.fromkeys(groups.tolist())]
+
+
+class _NearestNeighbourCV:
+    """Cross-validated accuracy of a k-NN vote on standardised features, for many subsets.
+
+    The wrappers' default classifier, written for their access pattern: squared
+    Euclidean distances are sums over features, so the distances of a subset with one unit
+    more (forward) or less (backward) are the current distances plus or minus that unit's
+    share, and every candidate costs one neighbour search instead of a model fit. Same
+    result as ``make_pipeline(StandardScaler(), KNeighborsClassifier(k))`` up to ties.
+    """
+
+    def __init__(self, X, y, folds, k=10):
+        self.y = y
+        self.n_classes = int(y.max()) + 1
+        self.parts = []
+        for train, test in folds:
+            mu = X[train].mean(axis=0)
+            sd = X[train].std(axis=0)
+            sd = np.where(sd > 0, sd, 1.0)
+            self.parts.append(((X[train] - mu) / sd, (X[test] - mu) / sd, y[train], y[test]))
+        self.k = k
+        self.base = None
+
+    @staticmethod
+    def _sq(a, b):
+        return cdist(a, b, metric="sqeuclidean") if a.shape[1] else np.zeros((a.shape[0], b.shape[0]))
+
+    def set_base(self, cols):
+        """Distances on the current subset, per fold."""
+        self.base = [self._sq(te[:, cols], tr[:, cols]) for tr, te, _, _ in self.parts]
+
+    def _vote_accuracy(self, D, ytr, yte):
+        k = min(self.k, D.shape[1])
+        nn = np.argpartition(D, k - 1, axis=1)[:, :k] if k < D.shape[1] else np.argsort(D, axis=1)
+        votes = np.zeros((D.shape[0], self.n_classes))
+        np.add.at(votes, (np.arange(D.shape[0])[:, None], ytr[nn]), 1.0)
+        return float(np.mean(votes.argmax(axis=1) == yte))
+
+    def accuracy(self, cols):
+        if cols.size == 0:
+            return _majority_accuracy(self.parts)
+        accs = []
+        for tr, te, ytr, yte in self.parts:
+            accs.append(self._vote_accuracy(self._sq(te[:, cols], tr[:, cols]), ytr, yte))
+        return float(np.mean(accs))
+
+    def accuracy_changed(self, unit, sign):
+        """Accuracy of the base subset with ``unit`` added (sign=+1) or removed (-1)."""
+        accs = []
+        for D, (tr, te, ytr, yte) in zip(self.base, self.parts):
+            accs.append(self._vote_accuracy(D + sign * self._sq(te[:, unit], tr[:, unit]), ytr, yte))
+        return float(np.mean(accs))
+
+
+def _majority_accuracy(parts):
+    """Accuracy of predicting each training fold's most frequent category (no feature)."""
+    accs = []
+    for _, _, ytr, yte in parts:
+        values, counts = np.unique(ytr, return_counts=True)
+        accs.append(np.mean(yte == values[np.argmax(counts)]))
+    return float(np.mean(accs))
+
+
+class _EstimatorCV:
+    """Cross-validated accuracy of any classifier on feature subsets (refits every time)."""
+
+    def __init__(self, estimator, X, y, folds, n_jobs=None):
+        self.estimator, self.X, self.y, self.folds, self.n_jobs = estimator, X, y, folds, n_jobs
+        self.parts = [(None, None, y[tr], y[te]) for tr, te in folds]
+        self.base = None
+
+    def accuracy(self, cols):
+        if cols.size == 0:
+            return _majority_accuracy(self.parts)
+        Xc = self.X[:, cols]
+        accs = []
+        for train, test in self.folds:
+            model = clone(self.estimator).fit(Xc[train], self.y[train])
+            accs.append(np.mean(model.predict(Xc[test]) == self.y[test]))
+        return float(np.mean(accs))
+
+    def set_base(self, cols):
+        self.base = cols
+
+    def accuracy_changed(self, unit, sign):
+        cols = np.concatenate([self.base, unit]) if sign > 0 else np.setdiff1d(self.base, unit)
+        return self.accuracy(cols)
+
+
+def _evaluator(estimator, X, y, cv, random_state, n_jobs):
+    folds = _folds(y, cv, check_random_state(random_state).randint(np.iinfo(np.int32).max))
+    if estimator is None:
+        return _NearestNeighbourCV(X, y, folds)
+    return _EstimatorCV(estimator, X, y, folds, n_jobs)
+
+
+def _folds(y, cv, seed):
+    n = y.shape[0]
+    if n < 2 * cv:
+        raise ValueError(f"X has {n} rows, too few to cross-validate with cv={cv} (need at least {2 * cv}).")
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="The least populated class")
+        return list(StratifiedKFold(cv, shuffle=True, random_state=seed).split(np.zeros(n), y))
+
+
+def _score_changes(evaluator, units, sign, n_jobs):
+    """Accuracy of the evaluator's base subset with each unit added or removed."""
+    if n_jobs in (None, 1):
+        return [evaluator.accuracy_changed(u, sign) for u in units]
+    return Parallel(n_jobs=n_jobs, prefer="threads")(delayed(evaluator.accuracy_changed)(u, sign) for u in units)
+
+
+def forward_selection(X, y, estimator=None, cv=5, max_features=None, groups=None, tol=0.0,
+                      random_state=None, n_jobs=None):
+    """Greedy forward selection with cross-validation (the thesis's ``sequentialfs``).
+
+    Parameters
+    ----------
+    X : array-like of shape (n_rows, n_features)
+    y : array-like of shape (n_rows,)
+    estimator : classifier or None, default=None
+        None: 10-nearest-neighbours on standardised features, computed incrementally
+        (see the module docstring); a classifier is refitted for every candidate.
+    cv : int, default=5
+        Stratified folds, the same for every candidate.
+    max_features : int or None, default=None
+        Stop after this many features (a group counts with all its features).
+    groups : array-like of shape (n_features,) or None, default=None
+        Group label per feature; a group is added as one unit (see :func:`feature_groups`).
+    tol : float, default=0.0
+        Keep adding while the accuracy rises by more than this.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the folds.
+    n_jobs : int or None, default=None
+        Candidates scored in parallel (joblib threads).
+
+    Returns
+    -------
+    selected : ndarray of int
+        Feature indices in the order they were added.
+    ranking : ndarray of int
+        All feature indices, best first: the selected ones in order, then the others by the
+        accuracy they would have given at the last step.
+    path : list of dict
+        ``{"features": [...], "accuracy": float}`` per step, starting with no feature.
+    """
+    X, y, _, y_idx = _check_Xy(X, y)
+    evaluator = _evaluator(estimator, X, y_idx, cv, random_state, n_jobs)
+    units = _units(groups, X.shape[1])
+    limit = X.shape[1] if max_features is None else max_features
+    chosen: list[int] = []
+    current = evaluator.accuracy(np.empty(0, int))
+    path = [{"features": [], "accuracy": current}]
+    last_scores = {}
+    while len(chosen) < len(units):
+        have = np.concatenate([units[u] for u in chosen]) if chosen else np.empty(0, int)
+        remaining = [u for u in range(len(units)) if u not in chosen and have.size + units[u].size <= limit]
+        if not remaining:
+            break
+        evaluator.set_base(have)
+        scores = _score_changes(evaluator, [units[u] for u in remaining], +1, n_jobs)
+        last_scores = dict(zip(remaining, scores))
+        best = remaining[int(np.argmax(scores))]
+        if last_scores[best] - current <= tol:
+            break
+        chosen.append(best)
+        current = last_scores.pop(best)
+        path.append({"features": units[best].tolist(), "accuracy": current})
+    rest = sorted((u for u in range(len(units)) if u not in chosen), key=lambda u: (-last_scores.get(u, -np.inf), u))
+    selected = np.concatenate([units[u] for u in chosen]).astype(int) if chosen else np.empty(0, int)
+    ranking = np.concatenate([units[u] for u in chosen + rest]).astype(int)
+    return selected, ranking, path
+
+
+def backward_elimination(X, y, estimator=None, cv=5, groups=None, tol=0.01, random_state=None, n_jobs=None):
+    """Greedy backward elimination with cross-validation (the thesis's Schemata search).
+
+    At every step each remaining unit (feature, or group of features) is removed in turn
+    and the subset with the highest cross-validated accuracy is kept. The elimination
+    runs to the last unit, which ranks all of them; the *selected* subset is the last one
+    whose accuracy stayed within ``tol`` of the best accuracy seen so far.
+
+    Parameters
+    ----------
+    X : array-like of shape (n_rows, n_features)
+    y : array-like of shape (n_rows,)
+    estimator : classifier or None, default=None
+        None: 10-nearest-neighbours on standardised features, computed incrementally
+        (see the module docstring); a classifier is refitted for every candidate.
+    cv : int, default=5
+    groups : array-like of shape (n_features,) or None, default=None
+        Group label per feature; a group is removed as one unit (see :func:`feature_groups`).
+    tol : float, default=0.01
+        Largest accepted drop of accuracy below the best seen.
+    random_state : int, RandomState instance or None, default=None
+    n_jobs : int or None, default=None
+
+    Returns
+    -------
+    selected : ndarray of int
+        Feature indices kept, best-ranked first.
+    ranking : ndarray of int
+        All feature indices, best (removed last) first.
+    path : list of dict
+        ``{"removed": [...], "accuracy": float}`` per step, starting with all features
+        (``removed`` empty) and ending with none.
+    """
+    X, y, _, y_idx = _check_Xy(X, y)
+    evaluator = _evaluator(estimator, X, y_idx, cv, random_state, n_jobs)
+    units = _units(groups, X.shape[1])
+
+    def cols(us):
+        return np.concatenate([units[u] for u in us]).astype(int) if us else np.empty(0, int)
+
+    remaining = list(range(len(units)))
+    best = evaluator.accuracy(cols(remaining))
+    path = [{"removed": [], "accuracy": best}]
+    removed: list[int] = []
+    stopped = None
+    while remaining:
+        if len(remaining) == 1:
+            u, acc = remaining[0], evaluator.accuracy(np.empty(0, int))
+        else:
+            evaluator.set_base(cols(remaining))
+            scores = _score_changes(evaluator, [units[v] for v in remaining], -1, n_jobs)
+            i = int(np.argmax(scores))
+            u, acc = remaining[i], scores[i]
+        if stopped is None and acc < best - tol:
+            stopped = list(remaining)
+        if stopped is None:
+            best = max(best, acc)
+        remaining.remove(u)
+        removed.append(u)
+        path.append({"removed": units[u].tolist(), "accuracy": acc})
+    order = removed[::-1]
+    kept = stopped if stopped is not None else []
+    return cols([u for u in order if u in kept]), cols(order), path
+
+
+class FeatureRelevance(BaseEstimator):
+    """Rank object features by their relevance to a behaviour's effect categories.
+
+    Parameters
+    ----------
+    method : {"relieff", "forward", "backward"}, default="relieff"
+    top : int or None, default=None
+        Number of features to select, best first. None: ReliefF selects the features whose
+        weight exceeds a tenth of the largest weight; the wrappers select what their
+        stopping rule keeps.
+    n_samples : int, default=1000
+        ReliefF's ``m``.
+    n_neighbors : int, default=10
+        ReliefF's ``k``.
+    estimator : classifier or None, default=None
+        Wrappers' classifier (None: 10-NN on standardised features).
+    cv : int, default=5
+        Wrappers' stratified folds.
+    feature_groups : array-like of shape (n_features,) or None, default=None
+        Wrappers move a group of features as one unit (see :func:`feature_groups`).
+    tol : float or None, default=None
+        Wrappers' tolerance; None is 0.0 for forward and 0.01 for backward.
+    max_features : int or None, default=None
+        Forward selection stops after this many features.
+    n_jobs : int or None, default=None
+        Wrappers score candidates in parallel.
+    random_state : int, RandomState instance or None, default=None
+
+    Attributes
+    ----------
+    scores_ : ndarray of shape (n_features,)
+        Higher is more relevant. ReliefF: its weights. Wrappers: ``1 - position / n_units``
+        of each feature's unit in the selection order (wrappers rank, they do not weigh).
+    ranking_ : ndarray of shape (n_features,)
+        Feature indices, most relevant first.
+    selected_ : ndarray of int
+        Indices of the selected features, most relevant first; never empty (when no
+        feature beats the majority vote the best-ranked unit is kept).
+    path_ : list of dict
+        Wrappers' accuracy after every step (empty for ReliefF).
+    n_features_in_ : int
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from learn import FeatureRelevance
+    >>> rng = np.random.default_rng(0)
+    >>> X = rng.random((300, 5))
+    >>> y = (X[:, 3] > 0.5).astype(int)
+    >>> FeatureRelevance(top=1, random_state=0).fit(X, y).selected_.tolist()
+    [3]
+    """
+
+    _parameter_constraints = {
+        "method": [StrOptions({"relieff", "forward", "backward"})],
+        "top": [Interval(numbers.Integral, 1, None, closed="left"), None],
+        "n_samples": [Interval(numbers.Integral, 1, None, closed="left")],
+        "n_neighbors": [Interval(numbers.Integral, 1, None, closed="left")],
+        "estimator": "no_validation",
+        "cv": [Interval(numbers.Integral, 2, None, closed="left")],
+        "feature_groups": ["array-like", None],
+        "tol": [Interval(numbers.Real, 0, None, closed="left"), None],
+        "max_features": [Interval(numbers.Integral, 1, None, closed="left"), None],
+        "n_jobs": [numbers.Integral, None],
+        "random_state": ["random_state"],
+    }
+
+    def __init__(self, method="relieff", top=None, n_samples=1000, n_neighbors=10, estimator=None, cv=5,
+                 feature_groups=None, tol=None, max_features=None, n_jobs=None, random_state=None):
+        self.method = method
+        self.top = top
+        self.n_samples = n_samples
+        self.n_neighbors = n_neighbors
+        self.estimator = estimator
+        self.cv = cv
+        self.feature_groups = feature_groups
+        self.tol = tol
+        self.max_features = max_features
+        self.n_jobs = n_jobs
+        self.random_state = random_state
+
+    def fit(self, X, y):
+        """Score and rank the features of ``X`` for the categories ``y``.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+            Initial object features (optionally with behaviour parameters).
+        y : array-like of shape (n_samples,)
+            Effect category of each row (rows of pruned categories removed beforehand).
+
+        Returns
+        -------
+        self : FeatureRelevance
+        """
+        self._validate_params()
+        X = validate_data(self, X, dtype=np.float64, ensure_all_finite=False)
+        X, y, _, _ = _check_Xy(X, y)
+        d = X.shape[1]
+        self.path_ = []
+        if self.method == "relieff":
+            self.scores_ = relieff(X, y, self.n_samples, self.n_neighbors, self.random_state)
+            self.ranking_ = np.argsort(-self.scores_, kind="stable")
+            if self.top is None:
+                best = self.scores_[self.ranking_[0]]
+                chosen = self.ranking_[self.scores_[self.ranking_] > max(0.1 * best, 0.0)]
+                self.selected_ = chosen if chosen.size else self.ranking_[:1]
+            else:
+                self.selected_ = self.ranking_[: self.top]
+            return self
+        if self.method == "forward":
+            tol = 0.0 if self.tol is None else self.tol
+            selected, ranking, path = forward_selection(
+                X, y, self.estimator, self.cv, self.max_features, self.feature_groups, tol, self.random_state, self.n_jobs
+            )
+        else:
+            tol = 0.01 if self.tol is None else self.tol
+            selected, ranking, path = backward_elimination(
+                X, y, self.estimator, self.cv, self.feature_groups, tol, self.random_state, self.n_jobs
+            )
+        units = _units(self.feature_groups, d)
+        unit_of = np.empty(d, dtype=int)
+        for i, cols in enumerate(units):
+            unit_of[cols] = i
+        position = {}
+        for f in ranking:
+            position.setdefault(unit_of[f], len(position))
+        self.scores_ = np.array([1.0 - position[unit_of[f]] / len(units) for f in range(d)])
+        self.ranking_ = ranking
+        if self.top is not None:
+            self.selected_ = ranking[: self.top]
+        else:  # nothing beat the majority vote: keep the best unit rather than nothing
+            self.selected_ = selected if selected.size else units[unit_of[ranking[0]]]
+        self.path_ = path
+        return self
+
+    def transform(self, X):
+        """Keep the selected features, in ``selected_`` order.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_samples, n_features)
+
+        Returns
+        -------
+        X_selected : ndarray of shape (n_samples, len(selected_))
+        """
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
+        _check_finite(X)
+        return X[:, self.selected_]

@@ -1,0 +1,407 @@
+"""learn/: effect categories, relevant features, calibrated predictors, evaluation.
+
+Every test plants a structure in synthetic data and asserts that it is found (or refused).
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+import skops.io as sio
+from sklearn.metrics import adjusted_rand_score
+from sklearn.utils.estimator_checks import check_estimator
+
+from features import FeatureSchema
+from learn import (
+    TRUSTED_TYPES,
+    AffordancePredictor,
+    EffectCategories,
+    FeatureRelevance,
+    XMeans,
+    backward_elimination,
+    baseline_scores,
+    evaluate_predictions,
+    feature_groups,
+    forward_selection,
+    relieff,
+)
+
+SCHEMA = FeatureSchema(
+    names=("visibility", "x", "y", "z", "h0", "h1", "h2", "h3"),
+    channels=("visibility",) + ("position",) * 3 + ("shape",) * 4,
+)
+POSITION_CENTRES = np.array([[0.0, 0.0, 0.0], [0.12, 0.0, 0.0], [0.0, -0.1, 0.15]])
+SHAPE_CENTRES = np.array([[0.0, 0.0, 0.0, 0.0], [0.04, -0.04, 0.04, -0.04]])
+
+
+def planted_effects(n=1200, seed=0, rare=0.0):
+    """Effects with independent planted channel categories: visibility 0/-1 (30 %),
+    three position clusters, two shape clusters; optionally a rare far position cluster."""
+    rng = np.random.default_rng(seed)
+    vis = (rng.random(n) < 0.3).astype(int)
+    pos = rng.integers(0, 3, n)
+    shp = rng.integers(0, 2, n)
+    E = np.column_stack([
+        -vis.astype(float),
+        POSITION_CENTRES[pos] + rng.normal(0, 0.01, (n, 3)),
+        SHAPE_CENTRES[shp] + rng.normal(0, 0.004, (n, 4)),
+    ])
+    rare_rows = np.empty(0, int)
+    if rare:
+        rare_rows = rng.choice(n, int(rare * n), replace=False)
+        E[rare_rows, 1:4] = np.array([0.5, 0.5, 0.5]) + rng.normal(0, 0.01, (rare_rows.size, 3))
+    return E, vis, pos, shp, rare_rows
+
+
+# ---------------------------------------------------------------------------- X-means
+@pytest.mark.parametrize("k", [3, 4])
+def test_xmeans_recovers_planted_blobs(k):
+    rng = np.random.default_rng(k)
+    centres = np.array([[0, 0], [6, 0], [0, 6], [6, 6]])[:k]
+    truth = rng.integers(0, k, 400)
+    X = centres[truth] + rng.normal(0, 0.7, (400, 2))
+    model = XMeans(k_max=8, random_state=0).fit(X)
+    assert model.n_clusters_ == k
+    assert adjusted_rand_score(truth, model.labels_) == pytest.approx(1.0)
+    assert np.array_equal(model.predict(X), model.labels_)
+
+
+def test_xmeans_single_blob_is_one_cluster():
+    X = np.random.default_rng(1).normal(size=(500, 3))
+    model = XMeans(k_max=6, random_state=0).fit(X)
+    assert model.n_clusters_ == 1
+    assert set(model.labels_) == {0}
+
+
+def test_xmeans_degenerate_inputs():
+    same = np.ones((20, 3))
+    assert XMeans(k_max=5, random_state=0).fit(same).n_clusters_ == 1
+    # three distinct points repeated: k_max above the number of distinct rows
+    three = np.repeat(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), 7, axis=0)
+    model = XMeans(k_min=1, k_max=10, random_state=0).fit(three)
+    assert model.n_clusters_ == 3
+    # 0 / -1 visibility effects split exactly
+    vis = np.r_[np.zeros(30), -np.ones(10)][:, None]
+    model = XMeans(random_state=0).fit(vis)
+    assert model.n_clusters_ == 2
+    assert adjusted_rand_score(vis[:, 0], model.labels_) == 1.0
+
+
+def test_xmeans_deterministic_and_refuses_nan():
+    X = np.random.default_rng(2).normal(size=(200, 2))
+    X[:100] += 5
+    a = XMeans(random_state=3).fit(X)
+    b = XMeans(random_state=3).fit(X)
+    assert np.array_equal(a.labels_, b.labels_) and np.allclose(a.cluster_centers_, b.cluster_centers_)
+    X[4, 1] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        XMeans().fit(X)
+
+
+# ------------------------------------------------------------------ effect categories
+def test_hierarchical_recovers_channels_and_product():
+    E, vis, pos, shp, _ = planted_effects()
+    ec = EffectCategories(schema=SCHEMA, random_state=0).fit(E)
+    assert {ch: len(c) for ch, c in ec.channel_counts_.items()} == {"visibility": 2, "position": 3, "shape": 2}
+    for ch, truth in (("visibility", vis), ("position", pos), ("shape", shp)):
+        assert adjusted_rand_score(truth, ec.channel_labels_[ch]) == 1.0
+    assert ec.n_categories_ == 12
+    product = vis * 6 + pos * 2 + shp
+    assert (ec.labels_ >= 0).all()
+    assert adjusted_rand_score(product, ec.labels_) == 1.0
+    # ids ordered by count; prototypes are member means in original units
+    assert np.all(np.diff(ec.counts_) <= 0)
+    assert ec.counts_.sum() == len(E)
+    for c in range(ec.n_categories_):
+        members = ec.labels_ == c
+        assert np.allclose(ec.prototypes_[c], E[members].mean(axis=0))
+        row = np.flatnonzero(members)[0]
+        expected = np.r_[-vis[row], POSITION_CENTRES[pos[row]], SHAPE_CENTRES[shp[row]]]
+        assert np.allclose(ec.prototypes_[c], expected, atol=0.005)
+    assert np.array_equal(ec.predict(E), ec.labels_)
+    # channel names as a plain tuple work the same
+    ec2 = EffectCategories(schema=SCHEMA.channels, random_state=0).fit(E)
+    assert np.array_equal(ec2.labels_, ec.labels_)
+
+
+def test_frequency_pruning_drops_rare_category_with_members():
+    E, vis, pos, shp, rare = planted_effects(rare=0.01)
+    ec = EffectCategories(schema=SCHEMA, prune="frequency", min_fraction=0.03, random_state=0).fit(E)
+    assert set(np.flatnonzero(ec.labels_ == -1)) == set(rare)
+    assert len(ec.channel_counts_["position"]) == 3  # the rare fourth cluster is gone
+    assert ec.n_categories_ == 12
+    kept = np.setdiff1d(np.arange(len(E)), rare)
+    assert adjusted_rand_score((vis * 6 + pos * 2 + shp)[kept], ec.labels_[kept]) == 1.0
+    assert (ec.counts_ >= 0.03 * len(E)).all()
+    # a held-out effect from the rare cluster still gets the nearest kept category
+    assert ec.predict(E[rare]).min() >= 0
+
+
+def test_product_categories_under_threshold_are_dropped():
+    rng = np.random.default_rng(5)
+    n = 1000
+    vis = (rng.random(n) < 0.5).astype(int)
+    pos = np.where(vis == 1, rng.random(n) < 0.02, rng.integers(0, 2, n)).astype(int)  # V1 ^ P1 is rare
+    E = np.column_stack([-vis, np.array([[0.0, 0.0], [0.2, 0.1]])[pos] + rng.normal(0, 0.01, (n, 2))])
+    ec = EffectCategories(schema=("visibility", "position", "position"), random_state=0).fit(E)
+    rare = (vis == 1) & (pos == 1)
+    assert 0 < rare.sum() < 0.03 * n
+    assert ec.n_categories_ == 3
+    assert (ec.labels_[rare] == -1).all() and (ec.labels_[~rare] >= 0).all()
+
+
+def test_predictability_collapses_unpredictable_channel():
+    rng = np.random.default_rng(0)
+    n = 900
+    X = rng.random((n, 4))
+    vis = (X[:, 1] > 0.75).astype(int)                    # predictable from X
+    pos = np.digitize(X[:, 0], [1 / 3, 2 / 3])            # predictable from X
+    shp = rng.integers(0, 2, n)                           # random: unpredictable
+    E = np.column_stack([
+        -vis, POSITION_CENTRES[pos] + rng.normal(0, 0.01, (n, 3)), SHAPE_CENTRES[shp] + rng.normal(0, 0.004, (n, 4)),
+    ])
+    freq = EffectCategories(schema=SCHEMA, random_state=0).fit(E)
+    assert len(freq.channel_counts_["shape"]) == 2  # the clusters are real ...
+    ec = EffectCategories(schema=SCHEMA, prune="predictability", random_state=0).fit(E, X)
+    assert len(ec.channel_counts_["shape"]) == 1    # ... but cannot be predicted
+    assert ec.channel_k_max_["shape"] == 1
+    assert len(ec.channel_counts_["visibility"]) == 2 and len(ec.channel_counts_["position"]) == 3
+    assert ec.n_categories_ == 6
+    assert adjusted_rand_score(vis * 3 + pos, ec.labels_) == 1.0
+    assert min(ec.predictability_["channel"]["position"]) >= 0.75
+
+
+def test_predictability_drops_unpredictable_product():
+    rng = np.random.default_rng(1)
+    n = 900
+    X = rng.random((n, 3))
+    pos = (X[:, 0] >= 0.5).astype(int)
+    vis = (X[:, 1] > 0.7) & (pos == 0)
+    noise = rng.choice(np.flatnonzero(pos == 1), int(0.08 * (pos == 1).sum()), replace=False)
+    vis[noise] = True  # V1 ^ P1 happens at random
+    E = np.column_stack([-vis.astype(float), np.where(pos[:, None] == 1, 0.15, 0.0) + rng.normal(0, 0.01, (n, 2))])
+    ec = EffectCategories(schema=("visibility", "position", "position"), prune="predictability",
+                          random_state=0).fit(E, X)
+    assert set(np.flatnonzero(ec.labels_ == -1)) == set(noise)
+    assert ec.n_categories_ == 3
+    dropped = [c for c in ec.predictability_["category"] if c["balanced_accuracy"] < 0.75]
+    assert len(dropped) == 1 and dropped[0]["count"] == noise.size
+
+
+def test_kmeans_baseline_and_errors():
+    E, vis, pos, shp, _ = planted_effects(n=600)
+    km = EffectCategories(schema=SCHEMA, method="kmeans", k=2, min_fraction=0.0, random_state=0).fit(E)
+    assert km.n_categories_ == 2 and set(km.labels_) == {0, 1}
+    assert km.channel_labels_ == {}
+    assert np.array_equal(km.predict(E), km.labels_)
+    with pytest.raises(ValueError, match="fit\\(E, X\\)"):
+        EffectCategories(schema=SCHEMA, prune="predictability").fit(E)
+    with pytest.raises(ValueError, match="schema"):
+        EffectCategories().fit(E)
+    with pytest.raises(ValueError, match="E has 8 features, but the schema names 3"):
+        EffectCategories(schema=("a", "b", "b")).fit(E)
+    bad = E.copy()
+    bad[3, 2] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        EffectCategories(schema=SCHEMA).fit(bad)
+    ec = EffectCategories(schema=SCHEMA, random_state=0).fit(E)
+    with pytest.raises(ValueError, match="E has 3 features, but EffectCategories is expecting 8"):
+        ec.predict(E[:, :3])
+    again = EffectCategories(schema=SCHEMA, random_state=0).fit(E)
+    assert np.array_equal(again.labels_, ec.labels_) and np.array_equal(again.prototypes_, ec.prototypes_)
+
+
+# ------------------------------------------------------------------------- relevance
+def relevance_data(n=600, seed=0):
+    rng = np.random.default_rng(seed)
+    X = rng.normal(size=(n, 12))
+    y = np.zeros(n, int)
+    y[X[:, 7] > 0.3] = 1
+    y[(X[:, 2] < -0.3) & (y == 0)] = 2
+    return X, y
+
+
+def test_relieff_ranks_planted_features_first():
+    X, y = relevance_data()
+    w = relieff(X, y, n_samples=300, random_state=0)
+    assert set(np.argsort(-w)[:2]) == {2, 7}
+    assert w[[2, 7]].min() > 5 * np.abs(np.delete(w, [2, 7])).max()
+    fr = FeatureRelevance(random_state=0).fit(X, y)
+    assert set(fr.selected_) == {2, 7}
+    assert sorted(fr.ranking_) == list(range(12))
+    assert np.array_equal(fr.transform(X), X[:, fr.selected_])
+
+
+def test_forward_selection_finds_planted_features():
+    X, y = relevance_data()
+    selected, ranking, path = forward_selection(X, y, random_state=0)
+    assert set(selected[:2]) == {2, 7}
+    assert set(ranking[:2]) == {2, 7}
+    assert path[2]["accuracy"] > path[0]["accuracy"] + 0.3
+    fr = FeatureRelevance(method="forward", top=2, random_state=0).fit(X, y)
+    assert set(fr.selected_) == {2, 7}
+    assert fr.scores_[[2, 7]].min() > np.delete(fr.scores_, [2, 7]).max()
+
+
+def test_backward_elimination_keeps_planted_group():
+    X, y = relevance_data()
+    groups = np.array([0, 0, 1, 2, 3, 3, 3, 4, 5, 5, 5, 5])  # 2 and 7 are single units
+    selected, ranking, path = backward_elimination(X, y, groups=groups, random_state=0)
+    assert set(ranking[:2]) == {2, 7}
+    assert {2, 7} <= set(selected)
+    assert path[0]["removed"] == [] and path[-1]["accuracy"] < path[0]["accuracy"] - 0.3
+    fr = FeatureRelevance(method="backward", feature_groups=groups, random_state=0).fit(X, y)
+    assert set(fr.ranking_[:2]) == {2, 7}
+
+
+def test_feature_groups_treat_histograms_as_units():
+    from features import object_schema
+
+    g = feature_groups(object_schema())
+    assert len(set(g)) == 1 + 6 + 2
+    schema = object_schema()
+    assert len(set(g[schema.channel_indices("shape")])) == 2
+
+
+def test_relevance_refuses_bad_input():
+    X, y = relevance_data(n=40)
+    with pytest.raises(ValueError, match="only one class"):
+        relieff(X, np.zeros(40))
+    with pytest.raises(ValueError, match="too few to cross-validate"):
+        forward_selection(X[:6], y[:6], cv=5)
+    X[0, 0] = np.inf
+    with pytest.raises(ValueError, match="NaN or infinite"):
+        FeatureRelevance().fit(X, y)
+
+
+# ------------------------------------------------------------------------ predictors
+def noisy_logistic(n, seed):
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(n, 1))
+    p = 1.0 / (1.0 + np.exp(-3.0 * x[:, 0]))
+    return x, (rng.random(n) < p).astype(int), p
+
+
+def test_calibrated_probabilities_match_truth():
+    x, y, _ = noisy_logistic(1500, 0)
+    model = AffordancePredictor(random_state=0).fit(x, y)
+    xt, _, pt = noisy_logistic(2000, 1)
+    proba = model.predict_proba(xt)
+    assert np.allclose(proba.sum(axis=1), 1.0)
+    assert np.abs(proba[:, 1] - pt).mean() < 0.07
+    assert 0.7 < model.cv_report_["cv_accuracy"] < 0.9  # the Bayes rate here is about 0.8
+
+
+def test_predictor_copes_with_tiny_categories():
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(300, 3))
+    y = (X[:, 0] > 0).astype(int)
+    y[:2] = 5   # two members
+    y[2] = 9    # one member
+    model = AffordancePredictor(random_state=0).fit(X, y)
+    assert model.classes_.tolist() == [0, 1, 5, 9]
+    proba = model.predict_proba(X)
+    assert proba.shape == (300, 4) and np.allclose(proba.sum(axis=1), 1.0)
+    assert proba[:, 3].max() < 0.1
+    assert model.cv_report_["singleton_classes"] == ["9"]
+    assert (model.predict(X[3:]) == y[3:]).mean() > 0.9
+
+
+def test_predictor_refuses_bad_input():
+    X = np.random.default_rng(0).normal(size=(50, 4))
+    with pytest.raises(ValueError, match="one class"):
+        AffordancePredictor().fit(X, np.ones(50))
+    bad = X.copy()
+    bad[7, 2] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        AffordancePredictor().fit(bad, np.arange(50) % 2)
+    with pytest.raises(ValueError, match="too few to cross-validate"):
+        AffordancePredictor(cv=3).fit(X[:4], [0, 1, 2, 2])
+    model = AffordancePredictor(C_grid=(1.0,), random_state=0).fit(X, np.arange(50) % 2)
+    with pytest.raises(ValueError, match="X has 3 features, but AffordancePredictor is expecting 4"):
+        model.predict(X[:, :3])
+    with pytest.raises(ValueError, match="NaN"):
+        model.predict_proba(bad)
+
+
+def test_predictor_round_trips_through_skops():
+    rng = np.random.default_rng(4)
+    X = rng.normal(size=(200, 3))
+    y = np.digitize(X[:, 0], [-0.5, 0.5])
+    reported = set()
+    for calibration, kernel in (("sigmoid", "rbf"), ("isotonic", "rbf"), ("temperature", "linear")):
+        model = AffordancePredictor(kernel=kernel, calibration=calibration, random_state=0).fit(X, y)
+        data = sio.dumps(model)
+        untrusted = sio.get_untrusted_types(data=data)
+        reported |= set(untrusted)
+        loaded = sio.loads(data, trusted=TRUSTED_TYPES)
+        assert np.array_equal(loaded.predict_proba(X), model.predict_proba(X))
+        assert loaded.cv_report_ == model.cv_report_
+        if calibration == "sigmoid":  # the default needs all but the temperature type
+            assert set(TRUSTED_TYPES) - set(untrusted) == {"sklearn.calibration._TemperatureScaling"}
+    assert reported == set(TRUSTED_TYPES)
+    with pytest.raises(Exception, match="[Uu]ntrusted"):
+        sio.loads(data, trusted=[])
+
+
+def test_predictor_is_deterministic():
+    X, y = relevance_data(n=300)
+    a = AffordancePredictor(random_state=7).fit(X, y).predict_proba(X)
+    b = AffordancePredictor(random_state=7).fit(X, y).predict_proba(X)
+    assert np.array_equal(a, b)
+
+
+# --------------------------------------------------------------- scikit-learn checks
+# Checks that skip themselves for reasons of this environment, not of the estimator.
+ENVIRONMENT_SKIPS = ("pandas is not installed", "SCIPY_ARRAY_API is not set")
+
+
+@pytest.mark.parametrize(
+    "estimator",
+    [XMeans(random_state=0), AffordancePredictor(C_grid=(1.0, 10.0), gamma_grid=(0.5,), random_state=0)],
+    ids=["XMeans", "AffordancePredictor"],
+)
+def test_scikit_learn_estimator_checks(estimator):
+    results = []
+
+    def record(estimator, check_name, exception, status, expected_to_fail, expected_to_fail_reason):
+        results.append((check_name, status, exception))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check_estimator(estimator, on_fail=None, on_skip=None, callback=record)
+    failed = [(name, repr(exc)) for name, status, exc in results if status == "failed"]
+    assert failed == []
+    odd_skips = [(name, str(exc)) for name, status, exc in results
+                 if status == "skipped" and not any(s in str(exc) for s in ENVIRONMENT_SKIPS)]
+    assert odd_skips == []
+    assert sum(status == "passed" for _, status, _ in results) > 40
+
+
+# ------------------------------------------------------------------------ evaluation
+def test_evaluate_predictions_by_hand():
+    proba = [[0.9, 0.1], [0.3, 0.7], [0.6, 0.4], [0.5, 0.5]]
+    r = evaluate_predictions([0, 1, 1, 7], proba, classes=[0, 1])
+    assert r["accuracy"] == 0.5  # the unseen category 7 counts as wrong
+    assert r["log_loss"] == pytest.approx(-(np.log(0.9) + np.log(0.7) + np.log(0.4) + np.log(1e-15)) / 4)
+    assert r["brier"] == pytest.approx((0.02 + 0.18 + 0.72 + 1.5) / 4)
+    assert r["ece"] == pytest.approx((0.1 + 0.3 + 0.6 + 0.5) / 4)
+    assert r["labels"] == [0, 1, 7]
+    assert r["confusion_matrix"] == [[1, 0, 0], [1, 1, 0], [1, 0, 0]]
+    assert r["n_unseen"] == 1
+    perfect = evaluate_predictions(["a", "b"], [[1.0, 0.0], [0.0, 1.0]], ["a", "b"])
+    assert perfect["accuracy"] == 1.0 and perfect["brier"] == 0.0 and perfect["ece"] == 0.0
+    with pytest.raises(ValueError, match="one column per class"):
+        evaluate_predictions([0, 1], [[1.0], [0.0]], [0, 1])
+
+
+def test_baseline_scores():
+    Xtr = np.array([[0.0], [0.1], [0.2], [1.0], [1.1], [1.2], [1.3]])
+    ytr = np.array([0, 0, 0, 1, 1, 1, 1])
+    Xte = np.array([[0.05], [1.15], [1.25]])
+    yte = np.array([0, 1, 3])
+    s = baseline_scores(Xtr, ytr, Xte, yte, random_state=0)
+    assert s["majority"] == pytest.approx(1 / 3)
+    assert s["knn"] == pytest.approx(2 / 3) and s["random_forest"] == pytest.approx(2 / 3)
