@@ -14,7 +14,7 @@ from typing import Callable
 
 import typer
 
-from afford_cli.commands import demo, explore, inspect, scenes
+from afford_cli.commands import cluster, demo, evaluate, explore, inspect, scenes, select_features, train
 from afford_cli.errors import AffordError
 
 app = typer.Typer(
@@ -43,7 +43,9 @@ def _guarded(command: Callable) -> Callable:
     return run
 
 
-for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
+for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore), ("cluster", cluster.cluster),
+                        ("select-features", select_features.select_features), ("train", train.train),
+                        ("evaluate", evaluate.evaluate),
                         ("inspect", inspect.inspect), ("demo", demo.demo)):
     app.command(_name)(_guarded(_command))
 

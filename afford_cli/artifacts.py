@@ -164,6 +164,9 @@ def write_artifact(path: str, data: bytes) -> None:
     if not parent.exists():
         raise AffordError(f"cannot write {path}: the directory {parent} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a saved artefact gets the usual mode
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)

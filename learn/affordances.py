@@ -14,6 +14,8 @@ so results do not depend on the order behaviours are processed in.
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from features import Interactions
@@ -60,7 +62,8 @@ def _check_rows(data: Interactions, b: int, rows: np.ndarray, what: str) -> None
 
 
 def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max: int = 5, k: int | None = None,
-                     prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0) -> tuple[dict, np.ndarray]:
+                     prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
+                     progress: Callable[[int], None] | None = None) -> tuple[dict, np.ndarray]:
     """Effect categories per behaviour; returns ``({name: EffectCategories}, labels)``.
 
     ``labels`` has one entry per row: the row's category within its behaviour, or -1 for a
@@ -78,11 +81,13 @@ def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max:
         ec.fit(effects[rows], X)
         labels[rows] = ec.labels_
         models[name] = ec
+        if progress is not None:
+            progress(b + 1)
     return models, labels
 
 
 def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "relieff", top: int | None = None,
-                  seed: int = 0, group_channels: bool = False) -> dict:
+                  seed: int = 0, group_channels: bool = False, progress: Callable[[int], None] | None = None) -> dict:
     """Feature relevance per behaviour (on rows with a kept category); ``{name: FeatureRelevance}``."""
     out = {}
     groups = feature_groups(data.schema) if group_channels else None
@@ -94,11 +99,14 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
             raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to tell apart")
         fr = FeatureRelevance(method=method, top=top, feature_groups=groups, random_state=behaviour_seed(seed, b))
         out[name] = fr.fit(data.before[rows], y)
+        if progress is not None:
+            progress(b + 1)
     return out
 
 
 def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str, np.ndarray], *,
-                     kernel: str = "rbf", seed: int = 0, n_jobs: int | None = None) -> dict:
+                     kernel: str = "rbf", seed: int = 0, n_jobs: int | None = None,
+                     progress: Callable[[int], None] | None = None) -> dict:
     """One calibrated predictor per behaviour; ``{name: AffordancePredictor}``."""
     out = {}
     for b, name in enumerate(data.behavior_names):
@@ -109,4 +117,6 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
             raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to predict")
         X = predictor_inputs(data.before[rows], data.params[rows], selected[name], n_params(data, b))
         out[name] = AffordancePredictor(kernel=kernel, n_jobs=n_jobs, random_state=behaviour_seed(seed, b)).fit(X, y)
+        if progress is not None:
+            progress(b + 1)
     return out

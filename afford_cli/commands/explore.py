@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 import typer
 from afford_cli.artifacts import artifact_bytes, write_artifact
 from afford_cli.datasets import behaviour_counts, interactions_members, outcome_table
-from afford_cli.commands.inspect import render_outcome_table
+from afford_cli.reports import render_outcome_table
 from afford_cli.errors import AffordError
 from afford_cli.options import Json, OutputPath, SceneName, Seed, Workers
 from afford_cli.output import Output

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from rich import box
 from rich.table import Table
 
 from afford_cli.artifacts import Artifact, read_artifact
 from afford_cli.datasets import interactions_from_artifact, outcome_table
 from afford_cli.options import InputPath, Json
 from afford_cli.output import Output
+from afford_cli.reports import render_categories, render_outcome_table
 
 
 def describe(art: Artifact) -> dict:
@@ -26,8 +26,12 @@ def describe(art: Artifact) -> dict:
         "verified": True,
         "members": sorted(m.get("members", {})),
         "features": m.get("schema", []),
-        "behaviors": [b["name"] for b in m.get("behaviors", [])],
+        "behavior_names": [b["name"] for b in m.get("behaviors", [])],
     }
+    if "effects" in m:
+        info["behaviors"] = _behaviour_reports(m)
+    if art.kind == "model":
+        info["training"] = m.get("training", {})
     if "n_interactions" in m:
         data = interactions_from_artifact(art)
         info.update({
@@ -74,25 +78,48 @@ def render(console, info: dict) -> None:
         console.print(ct)
     if info.get("outcomes"):
         render_outcome_table(console, info["outcomes"])
+    if info.get("behaviors"):
+        channels = _channels(info["features"])
+        for name, report in info["behaviors"].items():
+            render_categories(console, name, report["categories"], channels)
+            extra = []
+            if report.get("selected"):
+                extra.append(f"relevant features: {', '.join(report['selected'])}")
+            if report.get("cv"):
+                cv = report["cv"]
+                extra.append(f"cross-validated accuracy {100 * cv['cv_accuracy']:.1f}% "
+                             f"(C={cv['best_params'].get('C')}, gamma={cv['best_params'].get('gamma', '-')})")
+            for line in extra:
+                console.print(f"  {line}")
 
 
-def render_outcome_table(console, outcomes: dict) -> None:
-    """``{behaviour: {shape: {label: count}}}`` as one table."""
-    from features import OUTCOMES
+def _channels(features: list[dict]) -> list[tuple[str, list[str]]]:
+    out: dict[str, list[str]] = {}
+    for f in features:
+        out.setdefault(f["channel"], []).append(f["name"])
+    return list(out.items())
 
-    ot = Table(title="what physically happened (ground truth, never used to learn)", box=box.SIMPLE_HEAD)
-    ot.add_column("behaviour", no_wrap=True)
-    ot.add_column("shape", no_wrap=True, min_width=14)
-    for label in OUTCOMES:
-        ot.add_column(label, justify="right", no_wrap=True)
-    for behavior, shapes in outcomes.items():
-        for shape, counts in shapes.items():
-            ot.add_row(behavior, shape, *[str(counts.get(label, 0)) for label in OUTCOMES])
-    console.print(ot)
+
+def _behaviour_reports(m: dict) -> dict:
+    """Per behaviour: categories (id, count, prototype, outcomes), relevance, CV report."""
+    reports = {}
+    for name, eff in m.get("effects", {}).items():
+        cats = m.get("categories", {}).get(name, eff.get("categories", []))
+        report = {k: v for k, v in eff.items() if k != "categories"}
+        report["categories"] = cats
+        rel = m.get("relevance", {}).get(name)
+        if rel:
+            report["selected"] = rel.get("selected", [])
+            if "scores" in rel:
+                report["relevance"] = rel["scores"]
+        if name in m.get("cv", {}):
+            report["cv"] = m["cv"][name]
+        reports[name] = report
+    return reports
 
 
 def inspect(path: InputPath, json: Json = False) -> None:
-    """Report any afford artefact (kind, lineage, features, counts, outcomes) and verify its checksums."""
+    """Report any afford artefact (kind, lineage, features, categories, outcomes) and verify its checksums."""
     art = read_artifact(path)
     info = describe(art)
     Output(json).result(info, lambda console: render(console, info))

@@ -1,0 +1,78 @@
+"""``afford evaluate``: a model on held-out interactions, against baselines from the same run."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from afford_cli.artifacts import read_artifact
+from afford_cli.datasets import interactions_from_artifact
+from afford_cli.errors import AffordError
+from afford_cli.learning import load_model
+from afford_cli.options import Json, Seed
+from afford_cli.output import Output
+from afford_cli.reports import render_metrics
+
+
+def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
+    """Per behaviour: accuracy, log loss, Brier, ECE, confusion (and baselines)."""
+    from learn import baseline_scores, evaluate_predictions
+    from learn.affordances import predictor_inputs
+
+    model.check_schema(data.schema, "the data")
+    missing = [n for n in model.names if n not in data.behavior_names]
+    if missing:
+        raise AffordError(f"the data hold no interactions of behaviour {missing[0]!r}, which the model predicts")
+    out = {}
+    for name in model.names:
+        b = data.behavior_names.index(name)
+        rows = np.flatnonzero(data.behavior == b)
+        if rows.size == 0:
+            raise AffordError(f"the data hold no interactions of behaviour {name!r}")
+        # The true category, as training would have labelled the effect; effects of the
+        # kinds training discarded (rare ones) are counted apart, not scored.
+        y = model.effects[name].assign(data.effects[rows])
+        known = y >= 0
+        if not known.any():
+            raise AffordError(f"none of the {rows.size} {name!r} interactions falls into a category the model knows")
+        X = predictor_inputs(data.before[rows], data.params[rows], model.selected[name], model.n_params(name))
+        predictor = model.predictors[name]
+        proba = predictor.predict_proba(X[known])
+        m = evaluate_predictions(y[known], proba, predictor.classes_)
+        entry = {
+            "accuracy": m["accuracy"], "n_test": int(known.sum()), "n_unknown_effects": int((~known).sum()),
+            "n_categories": int(predictor.classes_.size), "log_loss": m["log_loss"], "brier": m["brier"],
+            "ece": m["ece"], "confusion_matrix": m["confusion_matrix"], "labels": m["labels"],
+        }
+        if baselines:
+            arrays = model.art.arrays
+            entry["baselines"] = baseline_scores(arrays[f"train_X.{name}"], arrays[f"train_y.{name}"].astype(int),
+                                                 X[known], y[known], random_state=seed)
+        out[name] = entry
+    return out
+
+
+def evaluate(
+    model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
+    data: Annotated[str, typer.Argument(help="Held-out interactions (an 'interactions' artefact, or '-').", metavar="DATA")],
+    baselines: Annotated[bool, typer.Option("--baselines", help="Also score majority-class, k-NN and random-forest predictors trained on the model's training rows.")] = False,
+    seed: Seed = 0,
+    json: Json = False,
+) -> None:
+    """Score a model's predictions on held-out interactions: accuracy, log loss, Brier, calibration."""
+    if model == "-" and data == "-":
+        raise typer.BadParameter("only one of MODEL and DATA can be read from stdin")
+    loaded = load_model(model)
+    rows = interactions_from_artifact(read_artifact(data, "interactions"))
+    result = {"behaviors": evaluate_model(loaded, rows, baselines, seed), "n_interactions": len(rows)}
+
+    def render(console):
+        render_metrics(console, result["behaviors"], f"held-out evaluation on {len(rows)} interactions")
+        unknown = {n: m["n_unknown_effects"] for n, m in result["behaviors"].items() if m["n_unknown_effects"]}
+        if unknown:
+            console.print("not scored (effects of kinds the model discarded as rare): "
+                          + ", ".join(f"{n} {c}" for n, c in unknown.items()))
+
+    Output(json).result(result, render)

@@ -1,0 +1,59 @@
+"""``afford select-features``: which object features matter, per behaviour; writes ``features``."""
+
+from __future__ import annotations
+
+import time
+from enum import Enum
+from typing import Annotated, Optional
+
+import typer
+from rich.table import Table
+
+from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.learning import features_members, read_effects, read_rows
+from afford_cli.options import InputPath, Json, OutputPath, Seed
+from afford_cli.output import Output
+
+
+class Method(str, Enum):
+    relieff = "relieff"
+    forward = "forward"
+    backward = "backward"
+
+
+def select_features(
+    path: InputPath,
+    output: OutputPath,
+    method: Annotated[Method, typer.Option(help="ReliefF (Algorithm 3), forward selection (sequentialfs) or backward elimination (schemata search).")] = Method.relieff,
+    top: Annotated[Optional[int], typer.Option("--top", min=1, help="Keep this many features, best first.")] = None,
+    group_channels: Annotated[bool, typer.Option("--group-channels", help="Wrappers move each 18-bin histogram as one unit.")] = False,
+    seed: Seed = 0,
+    json: Json = False,
+) -> None:
+    """Rank the object features by relevance to each behaviour's effect categories."""
+    from learn.affordances import rank_features
+
+    out = Output(json, stdout_busy=output == "-")
+    art, data = read_rows(path, ("effects", "features"))
+    labels, _ = read_effects(art, data)
+    start = time.perf_counter()
+    with out.progress(f"selecting features ({method.value})", len(data.behaviors)) as update:
+        relevance = rank_features(data, labels, method=method.value, top=top, seed=seed,
+                                  group_channels=group_channels, progress=update)
+    settings = {"method": method.value, "top": top, "group_channels": group_channels}
+    arrays, meta, blobs = features_members(art, data, relevance, settings)
+    write_artifact(output, artifact_bytes("features", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
+    result = {"output": output, "seconds": round(time.perf_counter() - start, 3),
+              "behaviors": {n: {"selected": r["selected"]} for n, r in meta["relevance"].items()}}
+
+    def render(console):
+        table = Table(title=f"relevant features ({method.value})")
+        table.add_column("behaviour", no_wrap=True)
+        table.add_column("n", justify="right")
+        table.add_column("features, most relevant first")
+        for name, r in meta["relevance"].items():
+            table.add_row(name, str(len(r["selected"])), ", ".join(r["selected"]))
+        console.print(table)
+        console.print(f"-> {output} ({result['seconds']:.1f} s)")
+
+    out.result(result, render)

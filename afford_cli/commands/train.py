@@ -1,0 +1,58 @@
+"""``afford train``: per-behaviour predictors with calibrated probabilities; writes a ``model``."""
+
+from __future__ import annotations
+
+import time
+from enum import Enum
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.learning import model_members, read_effects, read_rows, read_selection
+from afford_cli.options import InputPath, Json, OutputPath, Seed
+from afford_cli.output import Output
+
+
+class Kernel(str, Enum):
+    rbf = "rbf"
+    linear = "linear"
+
+
+def train(
+    path: InputPath,
+    output: OutputPath,
+    kernel: Annotated[Kernel, typer.Option(help="SVM kernel.")] = Kernel.rbf,
+    seed: Seed = 0,
+    json: Json = False,
+) -> None:
+    """Train each behaviour's effect-category predictor (thesis 8.4.2), probabilities calibrated."""
+    from learn.affordances import train_predictors
+
+    out = Output(json, stdout_busy=output == "-")
+    art, data = read_rows(path, ("effects", "features"))
+    labels, effects = read_effects(art, data)
+    selected = read_selection(art, data)
+    start = time.perf_counter()
+    with out.progress(f"training predictors ({kernel.value} SVM)", len(data.behaviors)) as update:
+        predictors = train_predictors(data, labels, selected, kernel=kernel.value, seed=seed, progress=update)
+    settings = {"kernel": kernel.value, "selection": art.kind}
+    arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings)
+    write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
+    result = {"output": output, "seconds": round(time.perf_counter() - start, 3),
+              "behaviors": {n: {"cv_accuracy": cv["cv_accuracy"], "best_params": cv["best_params"],
+                                "n_categories": len(meta["categories"][n])} for n, cv in meta["cv"].items()}}
+
+    def render(console):
+        table = Table(title="trained predictors")
+        for col in ("behaviour", "categories", "features", "C", "gamma", "cross-validated accuracy"):
+            table.add_column(col, no_wrap=True)
+        for name, cv in meta["cv"].items():
+            p = cv["best_params"]
+            table.add_row(name, str(len(meta["categories"][name])), str(len(selected[name])), f"{p.get('C')}",
+                          f"{p.get('gamma', '-'):.3g}" if "gamma" in p else "-", f"{100 * cv['cv_accuracy']:.1f}%")
+        console.print(table)
+        console.print(f"-> {output} ({result['seconds']:.1f} s)")
+
+    out.result(result, render)

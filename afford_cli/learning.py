@@ -1,0 +1,163 @@
+"""Effects, features and model artefacts: what each learning command adds, and reads back.
+
+``interactions`` -> ``effects`` (each row's category, the fitted categories per behaviour)
+-> ``features`` (relevance scores and chosen features per behaviour) -> ``model`` (no raw
+rows: prototypes, chosen features, fitted predictors and effect categories, the training
+matrices the baselines need, cross-validation reports and category reports).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from afford_cli.artifacts import Artifact, dump_estimator, read_artifact
+from afford_cli.datasets import interactions_from_artifact, interactions_members
+from afford_cli.errors import AffordError
+from features import OUTCOMES, FeatureSchema, Interactions
+from learn import TRUSTED_TYPES as PREDICTOR_TYPES
+
+__all__ = [
+    "TRUSTED", "read_rows", "effects_members", "read_effects", "features_members", "read_selection",
+    "category_report", "model_members", "LoadedModel", "load_model",
+]
+
+#: Every type a model file may hold; anything else is refused on load.
+TRUSTED = sorted(set(PREDICTOR_TYPES) | {"learn.effects.EffectCategories"})
+
+ROW_KINDS = ("interactions", "effects", "features")
+
+
+def read_rows(path: str, kinds: tuple[str, ...] = ROW_KINDS) -> tuple[Artifact, Interactions]:
+    art = read_artifact(path, kinds)
+    return art, interactions_from_artifact(art)
+
+
+def category_report(data: Interactions, labels: np.ndarray, b: int, prototypes: np.ndarray) -> list[dict]:
+    """Per category: id, count, prototype ``{feature: value}``, outcomes ``{label: fraction}``."""
+    rows = np.flatnonzero(data.behavior == b)
+    out = []
+    outcome = data.truth.get("outcome")
+    for c in range(prototypes.shape[0]):
+        members = rows[labels[rows] == c]
+        entry: dict[str, Any] = {
+            "id": c,
+            "count": int(members.size),
+            "prototype": {name: round(float(v), 5) for name, v in zip(data.schema.names, prototypes[c])},
+        }
+        if outcome is not None and members.size:
+            counts = np.bincount(outcome[members], minlength=len(OUTCOMES))
+            entry["outcomes"] = {label: round(float(n / members.size), 4) for label, n in zip(OUTCOMES, counts) if n}
+        out.append(entry)
+    return out
+
+
+def _blob_name(kind: str, behavior: str) -> str:
+    return f"{kind}.{behavior}"
+
+
+def effects_members(data: Interactions, labels: np.ndarray, models: dict, settings: dict) -> tuple[dict, dict, dict]:
+    arrays, meta = interactions_members(data)
+    arrays["category"] = labels.astype(np.int16)
+    blobs = {_blob_name("effects", name): dump_estimator(ec) for name, ec in models.items()}
+    summary = {}
+    for b, name in enumerate(data.behavior_names):
+        ec = models[name]
+        summary[name] = {
+            **settings,
+            "n_categories": int(ec.n_categories_),
+            "pruned_rows": int((labels[data.behavior == b] < 0).sum()),
+            "channel_categories": {ch: int(np.asarray(v).size) for ch, v in ec.channel_counts_.items()},
+            "categories": category_report(data, labels, b, ec.prototypes_),
+        }
+    meta["effects"] = summary
+    return arrays, meta, blobs
+
+
+def read_effects(art: Artifact, data: Interactions) -> tuple[np.ndarray, dict]:
+    """Each row's category and the fitted categories per behaviour."""
+    if "category" not in art.arrays or "effects" not in art.manifest:
+        raise AffordError(f"{art.source} holds no effect categories; run 'afford cluster' on it first")
+    models = {name: art.estimator(_blob_name("effects", name), TRUSTED) for name in data.behavior_names}
+    return art.arrays["category"].astype(int), models
+
+
+def features_members(art: Artifact, data: Interactions, relevance: dict, settings: dict) -> tuple[dict, dict, dict]:
+    arrays = dict(art.arrays)
+    meta = {k: v for k, v in art.manifest.items() if k not in _MANIFEST_OWN}
+    summary = {}
+    for name, fr in relevance.items():
+        arrays[f"selected.{name}"] = np.asarray(fr.selected_, dtype=np.int16)
+        arrays[f"relevance.{name}"] = np.asarray(fr.scores_, dtype=np.float64)
+        summary[name] = {**settings, "selected": [data.schema.names[i] for i in fr.selected_],
+                         "scores": {data.schema.names[i]: round(float(fr.scores_[i]), 5) for i in fr.ranking_}}
+    meta["relevance"] = summary
+    return arrays, meta, dict(art.blobs)
+
+
+def read_selection(art: Artifact, data: Interactions) -> dict[str, np.ndarray]:
+    """Chosen feature indices per behaviour (all features for an effects artefact)."""
+    if art.kind == "features":
+        return {name: art.arrays[f"selected.{name}"].astype(int) for name in data.behavior_names}
+    return {name: np.arange(len(data.schema)) for name in data.behavior_names}
+
+
+# manifest fields every artefact writes for itself
+_MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created", "command", "seed", "parents", "members"}
+
+
+def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict, selected: dict,
+                  predictors: dict, settings: dict) -> tuple[dict, dict, dict]:
+    from learn.affordances import behaviour_rows, n_params, predictor_inputs
+
+    arrays, blobs, cv, categories = {}, {}, {}, {}
+    for b, name in enumerate(data.behavior_names):
+        ec, model = effects[name], predictors[name]
+        rows = behaviour_rows(data, b, labels)
+        arrays[f"prototypes.{name}"] = ec.prototypes_
+        arrays[f"selected.{name}"] = np.asarray(selected[name], dtype=np.int16)
+        arrays[f"train_X.{name}"] = predictor_inputs(data.before[rows], data.params[rows], selected[name], n_params(data, b))
+        arrays[f"train_y.{name}"] = labels[rows].astype(np.int16)
+        blobs[_blob_name("effects", name)] = dump_estimator(ec)
+        blobs[_blob_name("predictor", name)] = dump_estimator(model)
+        cv[name] = model.cv_report_
+        categories[name] = category_report(data, labels, b, ec.prototypes_)
+    meta = {
+        "schema": data.schema.to_json(),
+        "behaviors": data.behaviors,
+        "scene": data.scene,
+        "training": {**settings, "n_interactions": len(data)},
+        "effects": art.manifest.get("effects", {}),
+        "relevance": {name: {"selected": [data.schema.names[i] for i in selected[name]]} for name in data.behavior_names},
+        "cv": cv,
+        "categories": categories,
+    }
+    return arrays, meta, blobs
+
+
+class LoadedModel:
+    """A model artefact with its estimators loaded (trusted types only)."""
+
+    def __init__(self, art: Artifact):
+        m = art.manifest
+        self.art = art
+        self.schema = FeatureSchema.from_json(m["schema"])
+        self.behaviors = list(m["behaviors"])
+        self.names = [b["name"] for b in self.behaviors]
+        self.selected = {n: art.arrays[f"selected.{n}"].astype(int) for n in self.names}
+        self.prototypes = {n: art.arrays[f"prototypes.{n}"] for n in self.names}
+        self.effects = {n: art.estimator(_blob_name("effects", n), TRUSTED) for n in self.names}
+        self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED) for n in self.names}
+
+    def n_params(self, name: str) -> int:
+        return len(self.behaviors[self.names.index(name)].get("parameters", []))
+
+    def check_schema(self, schema: FeatureSchema, what: str) -> None:
+        if schema != self.schema:
+            raise AffordError(f"{what} has another feature schema than the model ({len(schema)} features "
+                              f"against {len(self.schema)}); use data perceived the way the model's were")
+
+
+def load_model(path: str) -> LoadedModel:
+    return LoadedModel(read_artifact(path, "model"))

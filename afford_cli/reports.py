@@ -1,0 +1,80 @@
+"""Human renderings shared by several commands (the JSON carries the same numbers)."""
+
+from __future__ import annotations
+
+from rich import box
+from rich.table import Table
+from rich.text import Text
+
+__all__ = ["bar_row", "render_categories", "render_outcome_table", "render_metrics"]
+
+_GLYPHS = " ▁▂▃▄▅▆▇█"
+
+
+def bar_row(values: list[float], scale: float) -> Text:
+    """One glyph per value, height by |value| / scale, green up, red down (thesis fig. 8.4)."""
+    text = Text()
+    for v in values:
+        level = 0 if scale <= 0 else min(8, int(round(8 * abs(v) / scale)))
+        text.append(_GLYPHS[level] if level else "·", style="green" if v > 0 else "red" if v < 0 else "dim")
+    return text
+
+
+def render_categories(console, behavior: str, categories: list[dict], channels: list[tuple[str, list[str]]]) -> None:
+    """A behaviour's categories: size, prototype per channel as bar rows, what physically happened."""
+    table = Table(title=f"{behavior}: {len(categories)} effect categories", box=box.SIMPLE_HEAD)
+    table.add_column("id", justify="right")
+    table.add_column("n", justify="right")
+    scales = {}
+    for channel, names in channels:
+        table.add_column(channel, no_wrap=True)
+        scales[channel] = max((abs(c["prototype"][n]) for c in categories for n in names), default=0.0)
+    table.add_column("what happened (ground truth)", no_wrap=True)
+    for c in categories:
+        cells = [str(c["id"]), str(c["count"])]
+        for channel, names in channels:
+            values = [c["prototype"][n] for n in names]
+            if len(names) <= 6:  # short channels also get their numbers
+                row = bar_row(values, scales[channel])
+                row.append(" " + " ".join(f"{v:+.2f}" for v in values), style="dim")
+                cells.append(row)
+            else:
+                cells.append(bar_row(values, scales[channel]))
+        outcomes = c.get("outcomes", {})
+        cells.append(", ".join(f"{k} {100 * v:.0f}%" for k, v in sorted(outcomes.items(), key=lambda kv: -kv[1])))
+        table.add_row(*cells)
+    console.print(table)
+
+
+def render_outcome_table(console, outcomes: dict) -> None:
+    """``{behaviour: {shape: {label: count}}}`` as one table."""
+    from features import OUTCOMES
+
+    ot = Table(title="what physically happened (ground truth, never used to learn)", box=box.SIMPLE_HEAD)
+    ot.add_column("behaviour", no_wrap=True)
+    ot.add_column("shape", no_wrap=True, min_width=14)
+    for label in OUTCOMES:
+        ot.add_column(label, justify="right", no_wrap=True)
+    for behavior, shapes in outcomes.items():
+        for shape, counts in shapes.items():
+            ot.add_row(behavior, shape, *[str(counts.get(label, 0)) for label in OUTCOMES])
+    console.print(ot)
+
+
+def render_metrics(console, behaviors: dict, title: str) -> None:
+    """Per behaviour: accuracy, log loss, Brier, ECE, and baselines when present."""
+    table = Table(title=title, box=box.SIMPLE_HEAD)
+    for col in ("behaviour", "n test", "categories", "accuracy", "log loss", "Brier", "ECE"):
+        table.add_column(col, justify="left" if col == "behaviour" else "right", no_wrap=True)
+    with_base = any("baselines" in m for m in behaviors.values())
+    if with_base:
+        for col in ("majority", "k-NN", "forest"):
+            table.add_column(col, justify="right")
+    for name, m in behaviors.items():
+        row = [name, str(m["n_test"]), str(m["n_categories"]), f"{100 * m['accuracy']:.1f}%", f"{m['log_loss']:.3f}",
+               f"{m['brier']:.3f}", f"{m['ece']:.3f}"]
+        if with_base:
+            b = m.get("baselines", {})
+            row += [f"{100 * b[k]:.1f}%" for k in ("majority", "knn", "random_forest")]
+        table.add_row(*row)
+    console.print(table)
