@@ -14,7 +14,7 @@ from typing import Callable
 
 import typer
 
-from afford_cli.commands import cluster, demo, evaluate, explore, inspect, scenes, select_features, train
+from afford_cli.commands import cluster, demo, evaluate, explore, inspect, predict, scenes, select_features, train
 from afford_cli.errors import AffordError
 
 app = typer.Typer(
@@ -45,7 +45,7 @@ def _guarded(command: Callable) -> Callable:
 
 for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore), ("cluster", cluster.cluster),
                         ("select-features", select_features.select_features), ("train", train.train),
-                        ("evaluate", evaluate.evaluate),
+                        ("evaluate", evaluate.evaluate), ("predict", predict.predict),
                         ("inspect", inspect.inspect), ("demo", demo.demo)):
     app.command(_name)(_guarded(_command))
 

@@ -1,0 +1,162 @@
+"""The learning commands end to end on a small exploration, and their refusals."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from afford_cli.app import app
+from afford_cli.artifacts import artifact_bytes, read_artifact, write_artifact
+from afford_cli.datasets import interactions_from_artifact, interactions_members
+
+runner = CliRunner()
+
+
+def ok(args):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, (args, result.output)
+    return result
+
+
+@pytest.fixture(scope="module")
+def pipeline(tmp_path_factory):
+    d = tmp_path_factory.mktemp("learn")
+    ok(["explore", "--interactions", "480", "--seed", "4", "--workers", "2", "-o", str(d / "train.afford")])
+    ok(["explore", "--interactions", "160", "--seed", "5", "--workers", "2", "-o", str(d / "test.afford")])
+    ok(["cluster", str(d / "train.afford"), "-o", str(d / "effects.afford"), "--seed", "1"])
+    ok(["select-features", str(d / "effects.afford"), "-o", str(d / "features.afford"), "--top", "12"])
+    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
+    return d
+
+
+def test_each_artefact_names_its_parent(pipeline):
+    chain = ["train", "effects", "features", "model"]
+    arts = {name: read_artifact(str(pipeline / f"{name}.afford")) for name in chain}
+    for parent, child in zip(chain, chain[1:]):
+        assert arts[child].manifest["parents"] == [{"kind": arts[parent].kind, "sha256": arts[parent].sha256}]
+    assert [arts[n].kind for n in chain] == ["interactions", "effects", "features", "model"]
+
+
+def test_effect_categories_mean_something(pipeline):
+    info = json.loads(ok(["inspect", str(pipeline / "effects.afford"), "--json"]).stdout)
+    for name in ("push-forward", "push-left", "push-right"):
+        cats = info["behaviors"][name]["categories"]
+        assert all({"id", "count", "prototype", "outcomes"} <= set(c) for c in cats)
+        assert len(cats[0]["prototype"]) == 43
+        mostly = {max(c["outcomes"], key=c["outcomes"].get) for c in cats if max(c["outcomes"].values()) >= 0.8}
+        assert "no-change" in mostly and "dragged" in mostly and mostly & {"fell", "left-view"}
+        # the vanishing category is a visibility drop, the others keep the object in view
+        gone = [c for c in cats if c["outcomes"].get("fell", 0) + c["outcomes"].get("left-view", 0) >= 0.8]
+        assert all(c["prototype"]["visibility"] < -0.9 for c in gone)
+    lift = info["behaviors"]["lift"]["categories"]
+    lifted = [c for c in lift if c["outcomes"].get("lifted", 0) >= 0.8]
+    assert lifted and all(c["prototype"]["z_min"] > 0.1 for c in lifted)
+
+
+def test_model_reports_features_and_predicts(pipeline):
+    info = json.loads(ok(["inspect", str(pipeline / "model.afford"), "--json"]).stdout)
+    assert len(info["features"]) == 43 and info["kind"] == "model"
+    assert set(info["behaviors"]) == {"push-forward", "push-left", "push-right", "lift"}
+    assert all(len(b["selected"]) == 12 for b in info["behaviors"].values())
+    result = json.loads(ok(["evaluate", str(pipeline / "model.afford"), str(pipeline / "test.afford"),
+                            "--baselines", "--json"]).stdout)
+    for name, m in result["behaviors"].items():
+        assert {"accuracy", "n_test", "n_categories", "log_loss", "brier", "ece", "baselines"} <= set(m)
+        assert set(m["baselines"]) == {"majority", "knn", "random_forest"}
+        assert m["accuracy"] > m["baselines"]["majority"]  # it learned something
+        cm = np.array(m["confusion_matrix"])
+        assert cm.sum() == m["n_test"]
+
+
+def test_predict_with_check_runs_the_simulator(pipeline):
+    out = json.loads(ok(["predict", str(pipeline / "model.afford"), "--seed", "2", "--objects", "2", "--check", "--json"]).stdout)
+    assert len(out["objects"]) == 2
+    for obj in out["objects"]:
+        for name, p in obj["behaviors"].items():
+            assert abs(sum(p["probabilities"].values()) - 1) < 1e-3
+            assert "held" in p and "outcome" in p
+    assert out["checked"] == 8 and 0 <= out["held"] <= 8
+
+
+def test_predict_from_a_layout(pipeline, tmp_path):
+    layout = tmp_path / "ball.toml"
+    layout.write_text('[[object]]\nshape = "sphere"\nsize = [0.12]\nposition = [0.6, 0.0]\n')
+    out = json.loads(ok(["predict", str(pipeline / "model.afford"), "--layout", str(layout), "--json"]).stdout)
+    assert out["layout"][0]["shape"] == "sphere"
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[[object]]\nshape = "cone"\nsize = [0.12]\nposition = [0.6, 0.0]\n')
+    result = runner.invoke(app, ["predict", str(pipeline / "model.afford"), "--layout", str(bad)])
+    assert result.exit_code == 1
+
+
+def test_a_pipe_runs_cluster_select_train(pipeline):
+    env = dict(os.environ)
+    cmd = f"{sys.executable} -m afford_cli"
+    proc = subprocess.run(
+        f"{cmd} cluster {pipeline / 'train.afford'} -o - | {cmd} select-features - -o - --top 8 | "
+        f"{cmd} train - -o {pipeline / 'piped.afford'} --kernel linear",
+        shell=True, capture_output=True, env=env)
+    assert proc.returncode == 0, proc.stderr.decode()[-2000:]
+    assert read_artifact(str(pipeline / "piped.afford"), "model").manifest["training"]["kernel"] == "linear"
+
+
+def _variant(pipeline, tmp_path, name, change):
+    art = read_artifact(str(pipeline / "train.afford"))
+    data = change(interactions_from_artifact(art))
+    arrays, meta = interactions_members(data) if name != "nan" else _unchecked(data)
+    path = tmp_path / f"{name}.afford"
+    write_artifact(str(path), artifact_bytes("interactions", arrays, meta))
+    return path
+
+
+def _unchecked(data):
+    from afford_cli.datasets import behaviour_counts
+
+    arrays = {k: getattr(data, k) for k in ("before", "after", "behavior", "params", "episode", "step")}
+    arrays.update({"truth_" + k: v for k, v in data.truth.items()})
+    return arrays, {"schema": data.schema.to_json(), "behaviors": data.behaviors, "scene": data.scene,
+                    "shapes": data.shapes, "n_interactions": len(data), "counts": behaviour_counts(data)}
+
+
+def _err(args):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 1, result.output
+    return result.output
+
+
+def test_clear_errors(pipeline, tmp_path):
+    no_lift = _variant(pipeline, tmp_path, "nolift", lambda d: d.subset(np.flatnonzero(d.behavior != 3)))
+    assert "no interactions of behaviour 'lift'" in _err(["cluster", str(no_lift), "-o", str(tmp_path / "x")])
+
+    def nan(d):
+        d.before[3, 5] = np.nan
+        return d
+    assert "NaN" in _err(["cluster", str(_variant(pipeline, tmp_path, "nan", nan)), "-o", str(tmp_path / "x")])
+
+    few = _variant(pipeline, tmp_path, "few", lambda d: d.subset(np.arange(60)))
+    assert "needs at least" in _err(["cluster", str(few), "-o", str(tmp_path / "x")])
+
+    def one_category(d):
+        d.after[:] = d.before  # nothing ever happened
+        return d
+    flat = _variant(pipeline, tmp_path, "flat", one_category)
+    ok(["cluster", str(flat), "-o", str(tmp_path / "flat-effects.afford")])
+    assert "one effect category only" in _err(["train", str(tmp_path / "flat-effects.afford"), "-o", str(tmp_path / "x")])
+
+    from features import FeatureSchema
+
+    def other_schema(d):
+        names = tuple(n if n != "z_max" else "height" for n in d.schema.names)
+        d.schema = FeatureSchema(names, d.schema.channels)
+        return d
+    other = _variant(pipeline, tmp_path, "other", other_schema)
+    assert "another feature schema" in _err(["evaluate", str(pipeline / "model.afford"), str(other)])
+    assert "needs 'interactions'" in _err(["evaluate", str(pipeline / "model.afford"), str(pipeline / "effects.afford")])
+    assert "needs 'effects' or 'features'" in _err(["train", str(pipeline / "train.afford"), "-o", str(tmp_path / "x")])
+    assert not (tmp_path / "x").exists()
