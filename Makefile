@@ -33,6 +33,7 @@ test: imports
 
 bench: $(STAMP)
 	$(PY) benchmarks/explore.py
+	$(PY) benchmarks/learn.py
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache benchmarks/results

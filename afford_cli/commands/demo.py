@@ -1,4 +1,8 @@
-"""``afford demo``: the main job on the built-in table scene, stage by stage."""
+"""``afford demo``: the main job on the built-in table scene, stage by stage.
+
+Each stage is the same command a user would type (the demo calls the command functions),
+so what it prints is what those commands print.
+"""
 
 from __future__ import annotations
 
@@ -7,33 +11,36 @@ from typing import Annotated
 
 import typer
 
-from afford_cli.artifacts import artifact_bytes, read_artifact, write_artifact
-from afford_cli.commands.explore import make_scene, run_explore, summary
-from afford_cli.commands.inspect import describe, render
-from afford_cli.datasets import interactions_members
 from afford_cli.options import Seed, Workers
 from afford_cli.output import Output
 
 
 def demo(
     out_dir: Annotated[Path, typer.Option("--out", help="Directory for the demo's artefacts.")] = Path("demo-out"),
-    interactions: Annotated[int, typer.Option("--interactions", min=1, help="Interactions to explore.")] = 2000,
+    interactions: Annotated[int, typer.Option("--interactions", min=200, help="Interactions to learn from.")] = 2000,
     seed: Seed = 0,
     workers: Workers = 2,
 ) -> None:
-    """Explore the table scene and inspect what was recorded."""
-    out = Output()
+    """Explore the table scene, learn its affordances, and measure them on new interactions."""
+    from afford_cli.commands import cluster, evaluate, explore, inspect, predict, select_features, train
+
     out_dir.mkdir(parents=True, exist_ok=True)
-    console = out.report
-    console.rule("[bold]1. explore: the robot pushes and lifts random objects")
-    scene = make_scene("table")
-    data, seconds = run_explore(out, scene, episodes=None, interactions=interactions, seed=seed,
-                                workers=workers, max_steps=10)
-    path = out_dir / "table.interactions.afford"
-    arrays, meta = interactions_members(data)
-    write_artifact(str(path), artifact_bytes("interactions", arrays, meta, seed=seed))
-    s = summary(data, seconds)
-    console.print(f"recorded {s['interactions']} interactions in {s['episodes']} episodes "
-                  f"({s['interactions_per_second']}/s) -> {path}")
-    console.rule("[bold]2. inspect: what the file holds, verified")
-    render(console, describe(read_artifact(str(path))))
+    console = Output().report
+    path = {k: str(out_dir / f"{k}.afford") for k in ("interactions", "heldout", "effects", "features", "model")}
+
+    console.rule(f"[bold]1. explore: the robot pushes and lifts random objects ({interactions} interactions)")
+    explore.explore(output=path["interactions"], interactions=interactions, seed=seed, workers=workers)
+    console.rule("[bold]2. cluster: effect categories per behaviour, discovered without labels")
+    cluster.cluster(path["interactions"], path["effects"], seed=seed)
+    console.rule("[bold]3. select-features: what the robot must look at (ReliefF)")
+    select_features.select_features(path["effects"], path["features"], seed=seed)
+    console.rule("[bold]4. train: calibrated predictors per behaviour")
+    train.train(path["features"], path["model"], seed=seed)
+    console.rule("[bold]5. evaluate: on interactions the robot has not seen, against baselines")
+    explore.explore(output=path["heldout"], interactions=max(200, interactions // 4), seed=seed + 1, workers=workers)
+    evaluate.evaluate(path["model"], path["heldout"], baselines=True, seed=seed)
+    console.rule("[bold]6. predict: a new scene, checked in simulation")
+    predict.predict(path["model"], seed=seed + 2, objects=2, run_check=True)
+    console.rule("[bold]7. inspect: the model file, verified")
+    inspect.inspect(path["model"])
+    Output().info(f"artefacts in {out_dir}/")
