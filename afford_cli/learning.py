@@ -161,3 +161,14 @@ class LoadedModel:
 
 def load_model(path: str) -> LoadedModel:
     return LoadedModel(read_artifact(path, "model"))
+
+
+def forward_model(model: LoadedModel, min_probability: float = 0.02):
+    """The planner's forward model of a loaded model artefact."""
+    from plan.forward import BehaviorModel, ForwardModel
+
+    behaviors = []
+    for b, name in enumerate(model.names):
+        params = [(float(p["low"]), float(p["high"])) for p in model.behaviors[b].get("parameters", [])]
+        behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params))
+    return ForwardModel(behaviors, min_probability=min_probability)

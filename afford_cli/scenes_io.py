@@ -9,7 +9,7 @@ from afford_cli.errors import AffordError
 __all__ = ["scene_objects", "open_world"]
 
 
-def scene_objects(scene_name: str, seed: int | None, objects: int, layout: str | None):
+def scene_objects(scene_name: str, seed: int | None, objects: int, layout: str | None, reachable: bool = False):
     """The scene and its objects, from a layout file or drawn from the seed."""
     from afford_cli.commands.explore import make_scene
     from sim.layout import LayoutError, load_layout
@@ -23,7 +23,8 @@ def scene_objects(scene_name: str, seed: int | None, objects: int, layout: str |
     else:
         if seed is None:
             raise AffordError("give --layout FILE, or --seed S to draw a random scene")
-        specs = scene.sample_objects(np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(7,))), objects)
+        rng = np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(7,)))
+        specs = scene.sample_objects(rng, objects, reachable=reachable)
     try:
         scene.check_layout(specs)
     except ValueError as exc:

@@ -13,13 +13,15 @@ from afford_cli.errors import AffordError
 from afford_cli.learning import load_model
 from afford_cli.options import Json, Seed
 from afford_cli.output import Output
+from afford_cli.plots import PlotDir, evaluation_plots, plot_directory, written
 from afford_cli.reports import render_metrics
 
 
 def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
-    """Per behaviour: accuracy, log loss, Brier, ECE, confusion (and baselines)."""
+    """Per behaviour: accuracy, log loss, Brier, ECE, confusion, reliability bins (and baselines)."""
     from learn import baseline_scores, evaluate_predictions
     from learn.affordances import predictor_inputs
+    from learn.evaluate import reliability_bins
 
     model.check_schema(data.schema, "the data")
     missing = [n for n in model.names if n not in data.behavior_names]
@@ -45,6 +47,7 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
             "accuracy": m["accuracy"], "n_test": int(known.sum()), "n_unknown_effects": int((~known).sum()),
             "n_categories": int(predictor.classes_.size), "log_loss": m["log_loss"], "brier": m["brier"],
             "ece": m["ece"], "confusion_matrix": m["confusion_matrix"], "labels": m["labels"],
+            "reliability": reliability_bins(y[known], proba, predictor.classes_),
         }
         if baselines:
             arrays = model.art.arrays
@@ -60,13 +63,18 @@ def evaluate(
     baselines: Annotated[bool, typer.Option("--baselines", help="Also score majority-class, k-NN and random-forest predictors trained on the model's training rows.")] = False,
     seed: Seed = 0,
     json: Json = False,
+    plots: PlotDir = None,
 ) -> None:
     """Score a model's predictions on held-out interactions: accuracy, log loss, Brier, calibration."""
     if model == "-" and data == "-":
         raise typer.BadParameter("only one of MODEL and DATA can be read from stdin")
+    out = Output(json)
+    plot_dir = plot_directory(plots) if plots is not None else None
     loaded = load_model(model)
     rows = interactions_from_artifact(read_artifact(data, "interactions"))
     result = {"behaviors": evaluate_model(loaded, rows, baselines, seed), "n_interactions": len(rows)}
+    if plot_dir is not None:
+        result["plots"] = evaluation_plots(result["behaviors"], plot_dir)
 
     def render(console):
         render_metrics(console, result["behaviors"], f"held-out evaluation on {len(rows)} interactions")
@@ -75,4 +83,6 @@ def evaluate(
             console.print("not scored (effects of kinds the model discarded as rare): "
                           + ", ".join(f"{n} {c}" for n, c in unknown.items()))
 
-    Output(json).result(result, render)
+    out.result(result, render)
+    if plot_dir is not None:
+        out.info(written(result["plots"]))

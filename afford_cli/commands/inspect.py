@@ -8,6 +8,7 @@ from afford_cli.artifacts import Artifact, read_artifact
 from afford_cli.datasets import interactions_from_artifact, outcome_table
 from afford_cli.options import InputPath, Json
 from afford_cli.output import Output
+from afford_cli.plots import PlotDir, artefact_plots, plot_directory, written
 from afford_cli.reports import render_categories, render_outcome_table
 
 
@@ -118,8 +119,14 @@ def _behaviour_reports(m: dict) -> dict:
     return reports
 
 
-def inspect(path: InputPath, json: Json = False) -> None:
+def inspect(path: InputPath, json: Json = False, plots: PlotDir = None) -> None:
     """Report any afford artefact (kind, lineage, features, categories, outcomes) and verify its checksums."""
+    out = Output(json)
+    plot_dir = plot_directory(plots) if plots is not None else None
     art = read_artifact(path)
     info = describe(art)
-    Output(json).result(info, lambda console: render(console, info))
+    if plot_dir is not None:
+        info["plots"] = artefact_plots(info, plot_dir)
+    out.result(info, lambda console: render(console, info))
+    if plot_dir is not None:
+        out.info(written(info["plots"]))

@@ -102,13 +102,20 @@ class TableScene:
         y = float(rng.uniform(-w.table_width / 2 + hy, max(-w.table_width / 2 + hy, w.table_width / 2 - hy)))
         return ObjectSpec(shape, size, (round(x, 4), round(y, 4)), round(yaw, 3))
 
+    def within_reach(self, spec: ObjectSpec, margin: float = 0.05) -> bool:
+        """Is the object's centre inside the arm's reach (less ``margin``)?"""
+        hand = self.config.world.hand
+        return math.dist(spec.position, hand.shoulder) <= hand.reach - margin
+
     def sample_objects(self, rng: np.random.Generator, n: int = 1, min_gap: float = 0.05,
-                       restarts: int = 50, tries: int = 50) -> list[ObjectSpec]:
-        """``n`` random objects whose footprints keep ``min_gap`` apart."""
+                       restarts: int = 50, tries: int = 50, reachable: bool = False) -> list[ObjectSpec]:
+        """``n`` random objects whose footprints keep ``min_gap`` apart (all within reach if asked)."""
         for _ in range(restarts):
             out: list[ObjectSpec] = []
             for _ in range(tries):
                 cand = self.sample_object(rng)
+                if reachable and not self.within_reach(cand):
+                    continue
                 if all(math.dist(cand.position, o.position) >= cand.footprint_radius + o.footprint_radius + min_gap
                        for o in out):
                     out.append(cand)

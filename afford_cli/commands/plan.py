@@ -1,0 +1,170 @@
+"""``afford plan``: find the behaviour sequence most likely to reach a goal; run it if asked."""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated, Optional
+
+import numpy as np
+import typer
+from rich import box
+from rich.table import Table
+
+from afford_cli.errors import AffordError
+from afford_cli.learning import forward_model, load_model
+from afford_cli.options import Json, SceneName
+from afford_cli.output import Output
+from afford_cli.scenes_io import open_world, scene_objects
+
+
+class SearchMethod(str, Enum):
+    best_first = "best-first"
+    bfs = "bfs"
+
+
+def parse_goals(expressions: list[str], schema):
+    from plan.goals import GoalError, parse_goal
+
+    try:
+        return parse_goal(expressions, schema)
+    except GoalError as exc:
+        raise AffordError(str(exc)) from None
+
+
+def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int) -> dict:
+    """Plan in one scene (and execute with monitoring); the result as plain data."""
+    from plan.monitor import execute as run
+    from plan.search import search
+
+    world = open_world(scene, specs, seed)
+    start = world.perceive()
+    model.check_schema(scene.schema, "this scene's perception")
+    goal.check_objects(start.shape[0])
+    first = search(fm, start, goal, method, **limits)
+    out = {"seed": seed, "objects": start.shape[0], "plan": first.to_json(), "tree": first.tree[:12]}
+    if execute and first.found:
+        result = run(world, fm, goal, method=method, max_replans=max_replans, first=first, **limits)
+        out["execution"] = result.to_json()
+        out["reached"] = result.reached
+        out["replans"] = result.replans
+        # did the first plan, as planned, work without replanning?
+        out["first_plan_worked"] = result.reached and result.replans == 0
+    return out
+
+
+def render_plan(console, entry: dict, goal_text: list[str]) -> None:
+    p = entry["plan"]
+    console.print(f"goal: {' and '.join(goal_text)}")
+    if not p["found"]:
+        console.print(f"[red]no plan[/]: {p['reason']} ({p['expanded']} nodes expanded, {p['seconds']:.2f} s)")
+        return
+    table = Table(title=f"plan: {p['length']} steps, success probability {p['success_probability']:.2f} "
+                        f"({p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms)", box=box.SIMPLE_HEAD)
+    for col in ("step", "behaviour", "object", "alpha", "expected category", "p"):
+        table.add_column(col)
+    for i, s in enumerate(p["steps"], 1):
+        table.add_row(str(i), s["behavior"], str(s["object"]), ", ".join(f"{a:.2f}" for a in s["alpha"]) or "-",
+                      str(s["category"]), f"{s['probability']:.2f}")
+    console.print(table)
+    if entry.get("tree"):
+        console.print("search tree, first level (behaviour on object -> category, p, distance to goal):")
+        for n in entry["tree"]:
+            console.print(f"  {n['behavior']} on {n['object']} -> {n['category']} p={n['probability']:.2f} d={n['distance']:.2f}")
+    if "execution" in entry:
+        ex = entry["execution"]
+        for s in ex["executed"]:
+            mark = "[green]as predicted[/]" if s["as_predicted"] else f"[yellow]{s['note']}[/]"
+            console.print(f"  ran {s['behavior']} on {s['object']}: {mark}")
+        verdict = "[green]goal reached[/]" if ex["reached"] else f"[red]not reached[/]: {ex['reason']}"
+        console.print(f"{verdict} (replans: {ex['replans']})")
+
+
+def plan(
+    model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
+    goal: Annotated[list[str], typer.Option("--goal", help="OBJ:FEATURE=VALUE~RANGE; repeat for several (all must hold).")],
+    scene: SceneName = "table",
+    seed: Annotated[Optional[int], typer.Option("--seed", "-s", min=0, help="Draw a random scene from this seed.")] = None,
+    objects: Annotated[int, typer.Option("--objects", min=1, max=6, help="Objects in a drawn scene.")] = 1,
+    layout: Annotated[Optional[str], typer.Option("--layout", help="A TOML layout file that pins the scene.")] = None,
+    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")] = 4,
+    max_nodes: Annotated[int, typer.Option("--max-nodes", min=1, help="Most search nodes to expand.")] = 20000,
+    method: Annotated[SearchMethod, typer.Option("--search", help="Most probable plan (best-first) or the thesis's breadth-first chaining.")] = SearchMethod.best_first,
+    execute: Annotated[bool, typer.Option("--execute", help="Run the plan in the simulator, monitor it and replan on surprises.")] = False,
+    max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
+    episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
+    reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
+    json: Json = False,
+) -> None:
+    """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
+    if layout is not None and episodes > 1:
+        raise typer.BadParameter("--episodes draws random scenes; it does not go with --layout")
+    loaded = load_model(model)
+    fm = forward_model(loaded)
+    g = parse_goals(goal, loaded.schema)
+    limits = {"max_depth": max_depth, "max_nodes": max_nodes}
+    out = Output(json)
+    base = seed or 0
+    entries = []
+    if episodes == 1:
+        sc, specs = scene_objects(scene, seed, objects, layout, reachable)
+        entries.append(plan_once(loaded, fm, sc, specs, base, g, method.value, limits, execute, max_replans))
+    else:
+        with out.progress("planning episodes", episodes) as update:
+            for e in range(episodes):
+                sc, specs = scene_objects(scene, base + e, objects, None, reachable)
+                entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans))
+                update(e + 1)
+    result = summarise(entries, execute)
+    result["goal"] = g.to_json()
+    if episodes == 1:
+        result.update(entries[0])
+
+    def render(console):
+        if episodes == 1:
+            render_plan(console, entries[0], g.to_json())
+        else:
+            render_summary(console, result)
+
+    out.result(result, render)
+
+
+def summarise(entries: list[dict], executed: bool) -> dict:
+    by_length: dict[str, dict] = {}
+    probs, first_ok = [], []
+    for e in entries:
+        p = e["plan"]
+        if not p["found"]:
+            continue
+        key = str(p["length"])
+        slot = by_length.setdefault(key, {"found": 0, "reached": 0})
+        slot["found"] += 1
+        probs.append(p["success_probability"])
+        if executed:
+            slot["reached"] += int(e.get("reached", False))
+            first_ok.append(bool(e.get("first_plan_worked", False)))
+    found = sum(1 for e in entries if e["plan"]["found"])
+    out = {"episodes": len(entries), "found": found, "by_length": dict(sorted(by_length.items(), key=lambda kv: int(kv[0]))),
+           "mean_success_probability": round(float(np.mean(probs)), 4) if probs else None,
+           "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in entries])), 4),
+           "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in entries])), 1)}
+    if executed:
+        out["reached"] = sum(int(e.get("reached", False)) for e in entries)
+        out["first_plan_worked"] = int(sum(first_ok))
+    out["runs"] = entries if len(entries) > 1 else []
+    return out
+
+
+def render_summary(console, result: dict) -> None:
+    table = Table(title=f"{result['episodes']} scenes: plans found {result['found']}"
+                        + (f", goal reached {result['reached']}" if "reached" in result else ""), box=box.SIMPLE_HEAD)
+    for col in ("plan length", "found", "reached", "rate"):
+        table.add_column(col, justify="right")
+    for k, v in result["by_length"].items():
+        rate = f"{100 * v['reached'] / v['found']:.0f}%" if "reached" in result and v["found"] else "-"
+        table.add_row(k, str(v["found"]), str(v["reached"]) if "reached" in result else "-", rate)
+    console.print(table)
+    if result["mean_success_probability"] is not None:
+        console.print(f"mean predicted success probability {result['mean_success_probability']:.2f}"
+                      + (f"; first plans that worked without replanning: {result['first_plan_worked']} of {result['found']}"
+                         if "first_plan_worked" in result else ""))
+    console.print(f"mean search: {result['mean_expanded']:.0f} nodes, {1000 * result['mean_seconds']:.0f} ms")

@@ -1,0 +1,347 @@
+"""PNG figures for ``--plots DIR``: what an artefact holds, and how well a model predicts.
+
+``afford inspect --plots`` draws, per behaviour, the prototype effect of each category
+(thesis figures 8.4-8.7: one row per category, one panel per channel, signed bars) and
+the relevance of the features, and, for artefacts that carry rows, the ground-truth
+outcomes per behaviour and shape. ``afford evaluate --plots`` draws, per behaviour, the
+confusion matrix and the reliability diagram of the predicted probabilities.
+
+Every function takes the plain data the command already reports (``describe()`` of
+``afford inspect``, ``evaluate_model()`` of ``afford evaluate``), so a figure shows the
+numbers ``--json`` prints. matplotlib is imported inside the drawing functions: commands
+that do not plot never import it. Figures are ``matplotlib.figure.Figure`` objects on an
+Agg canvas rather than pyplot figures: nothing switches the process-wide backend and no
+figure is kept in pyplot's registry, so there is nothing to close; each figure is dropped
+once saved.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from afford_cli.errors import AffordError
+
+__all__ = [
+    "PlotDir", "plot_directory", "written", "artefact_plots", "evaluation_plots",
+    "prototypes_figure", "relevance_figure", "outcomes_figure", "confusion_figure", "reliability_figure",
+]
+
+#: ``--plots DIR``, shared by inspect and evaluate.
+PlotDir = Annotated[Optional[Path], typer.Option(
+    "--plots", metavar="DIR", help="Also write PNG figures into DIR (created if missing).")]
+
+DPI = 100
+TOP_FEATURES = 20
+_UP, _DOWN = "#2e8b3d", "#c8372d"              # the colours of the text reports' bar rows
+_SELECTED, _OTHER = "#d9822b", "#9aa5b1"
+_OUTCOME_COLOURS = {"fell": "#c8372d", "left-view": "#8e5ab5", "lifted": "#2f78c4",
+                    "dragged": "#e3a33b", "no-change": "#b8bec6"}
+
+
+# --------------------------------------------------------------------------- files
+
+def plot_directory(path: str | Path) -> Path:
+    """``path`` as a directory, created with its parents if missing; refused if it is a file."""
+    d = Path(path)
+    if d.exists() and not d.is_dir():
+        raise AffordError(f"the plot directory {d} is a file; give --plots a directory (it is created if missing)")
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise AffordError(f"cannot create the plot directory {d} ({exc.strerror or exc})") from None
+    return d
+
+
+def written(paths: list[str]) -> str:
+    """The stderr line listing the figures a command wrote."""
+    from rich.markup import escape
+
+    if not paths:
+        return "no plots written: nothing to draw"
+    return f"wrote {len(paths)} plot{'s' if len(paths) != 1 else ''}:" + "".join(f"\n  {escape(p)}" for p in paths)
+
+
+def _file_name(stem: str, behavior: str | None = None) -> str:
+    if behavior is None:
+        return f"{stem}.png"
+    return f"{stem}-{re.sub(r'[^A-Za-z0-9._-]+', '_', behavior)}.png"
+
+
+def _new_figure(width: float, height: float, **kwargs):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(width, height), layout="constrained", **kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _save(fig, path: Path) -> str:
+    try:
+        fig.savefig(path, dpi=DPI, format="png")
+    except OSError as exc:
+        raise AffordError(f"cannot write the plot {path} ({exc.strerror or exc})") from None
+    return str(path)
+
+
+# --------------------------------------------------------------------------- what a command draws
+
+def artefact_plots(info: dict, directory: Path) -> list[str]:
+    """Every figure ``afford inspect`` can draw from ``describe()``'s ``info``; the paths written."""
+    paths = []
+    features = info.get("features") or []
+    for name, report in (info.get("behaviors") or {}).items():
+        if report.get("categories"):
+            paths.append(prototypes_figure(directory / _file_name("prototypes", name), name,
+                                           report["categories"], features))
+        if report.get("relevance") or report.get("selected"):
+            paths.append(relevance_figure(directory / _file_name("relevance", name), name,
+                                          report.get("relevance"), report.get("selected", []), len(features)))
+    outcomes = info.get("outcomes") or {}
+    if any(n for shapes in outcomes.values() for labels in shapes.values() for n in labels.values()):
+        paths.append(outcomes_figure(directory / _file_name("outcomes"), outcomes))
+    return paths
+
+
+def evaluation_plots(behaviors: dict, directory: Path) -> list[str]:
+    """Confusion matrix and reliability diagram per behaviour from ``evaluate_model()``; the paths written."""
+    paths = []
+    for name, m in behaviors.items():
+        paths.append(confusion_figure(directory / _file_name("confusion", name), name, m))
+        paths.append(reliability_figure(directory / _file_name("reliability", name), name, m))
+    return paths
+
+
+# --------------------------------------------------------------------------- inspect
+
+def _channels(features: list[dict], categories: list[dict]) -> list[tuple[str, list[str]]]:
+    out: dict[str, list[str]] = {}
+    for f in features:
+        out.setdefault(f["channel"], []).append(f["name"])
+    if not out and categories:  # no schema in the manifest: one panel of whatever the prototypes name
+        out["features"] = list(categories[0]["prototype"])
+    return list(out.items())
+
+
+def _groups(names: list[str]) -> list[tuple[str, int, int]]:
+    """Runs of names sharing a prefix (``elevation_00..17`` -> ``elevation``): (prefix, start, stop)."""
+    runs: list[tuple[str, int, int]] = []
+    for i, n in enumerate(names):
+        prefix = n.rsplit("_", 1)[0]
+        if runs and runs[-1][0] == prefix:
+            runs[-1] = (prefix, runs[-1][1], i + 1)
+        else:
+            runs.append((prefix, i, i + 1))
+    return runs
+
+
+def _dominant(outcomes: dict) -> str:
+    if not outcomes:
+        return "no ground truth"
+    label, share = max(outcomes.items(), key=lambda kv: kv[1])
+    return f"{label} {100 * share:.0f}%"
+
+
+def prototypes_figure(path: Path, behavior: str, categories: list[dict], features: list[dict]) -> str:
+    """One row of signed bar panels per effect category, one panel per channel (thesis fig. 8.4-8.7).
+
+    Each row is labelled with the category id, its member count and the ground-truth outcome
+    most of its members had; bars are the prototype effect (after - before), green up, red
+    down, on one scale per channel.
+    """
+    channels = _channels(features, categories)
+    n_rows, n_cols = len(categories), len(channels)
+    widths = [max(0.9, len(names) ** 0.6) for _, names in channels]
+    fig = _new_figure(1.6 + 1.0 * sum(widths), 1.3 + 0.72 * n_rows)
+    axes = fig.subplots(n_rows, n_cols, squeeze=False, gridspec_kw={"width_ratios": widths})
+    for j, (channel, names) in enumerate(channels):
+        scale = max((abs(c["prototype"].get(n, 0.0)) for c in categories for n in names), default=0.0) or 1.0
+        x = range(len(names))
+        groups = _groups(names)
+        for i, cat in enumerate(categories):
+            ax = axes[i, j]
+            values = [cat["prototype"].get(n, 0.0) for n in names]
+            ax.bar(x, values, width=0.8, color=[_UP if v >= 0 else _DOWN for v in values])
+            ax.axhline(0.0, color="#444444", linewidth=0.6)
+            ax.set_xlim(-0.6, len(names) - 0.4)
+            ax.set_ylim(-1.1 * scale, 1.1 * scale)
+            for side in ("top", "right"):
+                ax.spines[side].set_visible(False)
+            if len(names) > 8:
+                for _, start, _stop in groups[1:]:
+                    ax.axvline(start - 0.5, color="#999999", linewidth=0.6, linestyle=":")
+            # Only the bottom row carries ticks (one scale per column): ticks are most of the drawing time.
+            if i < n_rows - 1:
+                ax.set_xticks([])
+                ax.set_yticks([])
+                ax.spines["bottom"].set_visible(False)
+            else:
+                ax.tick_params(labelsize=7, length=2)
+                ax.set_yticks([-scale, 0.0, scale], [f"{-scale:.2g}", "0", f"{scale:.2g}"])
+                if 1 < len(names) <= 8:
+                    ax.set_xticks(list(x), names, rotation=90)
+                elif len(names) > 8 and len(groups) < len(names):
+                    ax.set_xticks([(a + b - 1) / 2 for _, a, b in groups], [g for g, _, _ in groups])
+                else:
+                    ax.set_xticks([])
+            if i == 0:
+                ax.set_title(f"{channel} ({len(names)})", fontsize=9)
+            if j == 0:
+                ax.set_ylabel(f"category {cat['id']}\nn = {cat['count']}\n{_dominant(cat.get('outcomes', {}))}",
+                              rotation=0, ha="right", va="center", fontsize=8, labelpad=8)
+    fig.align_ylabels(axes[:, 0])
+    fig.suptitle(f"{behavior}: prototype effect (after - before) of its {n_rows} effect categories", fontsize=11)
+    return _save(fig, path)
+
+
+def relevance_figure(path: Path, behavior: str, scores: dict | None, selected: list[str], n_features: int = 0) -> str:
+    """Horizontal bars of the top relevance scores, the selected features highlighted.
+
+    A model artefact keeps which features were chosen but not their scores; then the chosen
+    features are listed, in the order chosen, as bars of equal length.
+    """
+    from matplotlib.patches import Patch
+
+    chosen = set(selected)
+    if scores:
+        ranked = sorted(scores.items(), key=lambda kv: -kv[1])[:TOP_FEATURES]
+        names = [n for n, _ in ranked]
+        values = [v for _, v in ranked]
+        below = len(chosen - set(names))
+        title = (f"{behavior}: feature relevance, top {len(names)} of {len(scores)}"
+                 f" ({len(chosen)} selected" + (f", {below} of them below these" if below else "") + ")")
+        xlabel = "relevance score"
+    else:
+        names = list(selected)
+        values = [1.0] * len(names)
+        title = f"{behavior}: the {len(names)} features the model uses" + (f" (of {n_features})" if n_features else "")
+        xlabel = "(the model stores which features were selected, not their scores)"
+    fig = _new_figure(6.4 if scores else 4.8, 1.2 + 0.24 * max(len(names), 3))
+    ax = fig.subplots()
+    y = range(len(names))
+    ax.barh(list(y), values, height=0.7, color=[_SELECTED if n in chosen else _OTHER for n in names])
+    ax.set_yticks(list(y), names, fontsize=8)
+    ax.invert_yaxis()
+    ax.axvline(0.0, color="#444444", linewidth=0.6)
+    ax.set_xlabel(xlabel, fontsize=8)
+    ax.tick_params(axis="x", labelsize=8)
+    if not scores:
+        ax.set_xticks([])
+    for side in ("top", "right"):
+        ax.spines[side].set_visible(False)
+    if scores:
+        ax.legend(handles=[Patch(color=_SELECTED, label="selected"), Patch(color=_OTHER, label="not selected")],
+                  fontsize=8, loc="lower right", frameon=False)
+    ax.set_title(title, fontsize=10)
+    return _save(fig, path)
+
+
+def outcomes_figure(path: Path, outcomes: dict) -> str:
+    """Stacked bars of ground-truth outcome counts, one panel per behaviour, one bar per shape."""
+    from matplotlib.patches import Patch
+
+    behaviours = list(outcomes)
+    labels = list(dict.fromkeys(l for shapes in outcomes.values() for counts in shapes.values() for l in counts))
+    colours = {l: _OUTCOME_COLOURS.get(l, f"C{k}") for k, l in enumerate(labels)}
+    fig = _new_figure(1.8 + 2.6 * len(behaviours), 4.0)
+    axes = fig.subplots(1, len(behaviours), squeeze=False, sharey=True)[0]
+    for ax, name in zip(axes, behaviours):
+        shapes = list(outcomes[name])
+        bottom = [0] * len(shapes)
+        for label in labels:
+            counts = [outcomes[name][s].get(label, 0) for s in shapes]
+            ax.bar(range(len(shapes)), counts, bottom=bottom, width=0.7, color=colours[label])
+            bottom = [b + c for b, c in zip(bottom, counts)]
+        ax.set_xticks(range(len(shapes)), shapes, rotation=35, ha="right", fontsize=8)
+        ax.tick_params(axis="y", labelsize=8)
+        ax.set_title(name, fontsize=10)
+        for side in ("top", "right"):
+            ax.spines[side].set_visible(False)
+    axes[0].set_ylabel("interactions", fontsize=9)
+    # legend top to bottom as the stacks read: the last label is on top
+    fig.legend(handles=[Patch(color=colours[l], label=l) for l in reversed(labels)], loc="outside right center",
+               fontsize=8, frameon=False, title="outcome", title_fontsize=8)
+    fig.suptitle("what physically happened, per behaviour and shape (ground truth, never used to learn)", fontsize=11)
+    return _save(fig, path)
+
+
+# --------------------------------------------------------------------------- evaluate
+
+def confusion_figure(path: Path, behavior: str, metrics: dict) -> str:
+    """The confusion matrix, rows true and columns predicted, coloured by row share, annotated with counts."""
+    import numpy as np
+
+    matrix = np.asarray(metrics["confusion_matrix"], dtype=int)
+    labels = [str(v) for v in metrics["labels"]]
+    n = len(labels)
+    rows = matrix.sum(axis=1, keepdims=True)
+    share = np.divide(matrix, rows, out=np.zeros(matrix.shape), where=rows > 0)
+    side = 2.4 + 0.42 * n
+    fig = _new_figure(side + 1.0, side)
+    ax = fig.subplots()
+    image = ax.imshow(share, cmap="Blues", vmin=0.0, vmax=1.0)
+    fontsize = 9 if n <= 10 else 7 if n <= 18 else 5
+    for i in range(n):
+        for j in range(n):
+            if matrix[i, j]:
+                ax.text(j, i, str(matrix[i, j]), ha="center", va="center", fontsize=fontsize,
+                        color="white" if share[i, j] > 0.55 else "#1a1a1a")
+    ax.set_xticks(range(n), labels, fontsize=fontsize)
+    ax.set_yticks(range(n), labels, fontsize=fontsize)
+    ax.set_xlabel("predicted category", fontsize=9)
+    ax.set_ylabel("true category", fontsize=9)
+    bar = fig.colorbar(image, ax=ax, shrink=0.8)
+    bar.set_label("share of the true category's rows", fontsize=8)
+    bar.ax.tick_params(labelsize=7)
+    n_test = metrics.get("n_test", int(matrix.sum()))
+    accuracy = metrics.get("accuracy", float(np.trace(matrix) / max(matrix.sum(), 1)))
+    ax.set_title(f"{behavior}: confusion on {n_test} held-out interactions\naccuracy {100 * accuracy:.1f}%",
+                 fontsize=10)
+    return _save(fig, path)
+
+
+def reliability_figure(path: Path, behavior: str, metrics: dict, n_bins: int = 10) -> str:
+    """Mean top-class confidence against observed accuracy per bin, over the bins' counts.
+
+    ``metrics["reliability"]`` holds the non-empty bins of :func:`learn.evaluate.reliability_bins`
+    (equal width, ``n_bins`` of them); a bin's place follows from its mean confidence, which
+    lies inside it.
+    """
+    bins = metrics.get("reliability", [])
+    width = 1.0 / n_bins
+    fig = _new_figure(5.2, 5.6)
+    top, bottom = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    top.plot([0, 1], [0, 1], linestyle="--", color="#888888", linewidth=1, label="perfectly calibrated")
+    conf = [b["confidence"] for b in bins]
+    acc = [b["accuracy"] for b in bins]
+    for c, a in zip(conf, acc):
+        top.plot([c, c], [c, a], color=_DOWN, linewidth=1.5, alpha=0.7)
+    top.plot(conf, acc, marker="o", color="#2f78c4", linewidth=1.2, label="model")
+    top.plot([], [], color=_DOWN, linewidth=1.5, alpha=0.7, label="gap (weighted mean = ECE)")
+    top.set_xlim(0, 1)
+    top.set_ylim(0, 1.02)
+    top.set_ylabel("observed accuracy", fontsize=9)
+    top.legend(fontsize=8, loc="best", frameon=False)
+    top.grid(alpha=0.3)
+    starts = [min(int(c * n_bins), n_bins - 1) * width for c in conf]
+    counts = [b["count"] for b in bins]
+    bottom.bar(starts, counts, width=width * 0.92, align="edge", color=_OTHER)
+    for s, k in zip(starts, counts):
+        bottom.text(s + width / 2, k, str(k), ha="center", va="bottom", fontsize=7)
+    bottom.set_ylim(0, 1.25 * max(counts, default=1))
+    bottom.set_ylabel("count", fontsize=9)
+    bottom.set_xlabel("mean predicted probability of the top category", fontsize=9)
+    for ax in (top, bottom):
+        ax.tick_params(labelsize=8)
+        for side in ("top", "right"):
+            ax.spines[side].set_visible(False)
+    n = metrics.get("n_test", sum(counts))
+    ece = metrics.get("ece")
+    head = f"ECE {ece:.3f}, " if ece is not None else ""
+    top.set_title(f"{behavior}: reliability of the predicted probabilities\n{head}{n} held-out interactions",
+                  fontsize=10)
+    return _save(fig, path)

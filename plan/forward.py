@@ -1,0 +1,123 @@
+"""The forward model: what the robot expects its behaviours to do (thesis 8.6).
+
+For an object f, a behaviour b and its parameters alpha, the predictor gives P(E | f, b,
+alpha) over b's effect categories; the next state of that object is f + prototype(E), and
+no other object changes (chapter 8). An object that the prototype makes vanish keeps its
+last seen position and shape with visibility 0, as perception does.
+
+Predictions depend only on the object's own features, so they are cached by the object's
+feature bytes: a search meets the same object vector in many states.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from itertools import product
+
+import numpy as np
+
+__all__ = ["BehaviorModel", "ForwardModel", "Outcome"]
+
+
+@dataclass
+class BehaviorModel:
+    """What the planner needs of one learned behaviour."""
+
+    name: str
+    predictor: object                  # predict_proba, classes_
+    selected: np.ndarray               # object-feature columns the predictor reads
+    prototypes: np.ndarray             # (n_categories, d) mean effects
+    parameters: list[tuple[float, float]] = field(default_factory=list)  # alpha ranges
+
+
+@dataclass(frozen=True)
+class Outcome:
+    category: int
+    probability: float
+    state: np.ndarray
+
+
+class ForwardModel:
+    """P(next state | state, behaviour, object, alpha) from learned predictors and prototypes.
+
+    Parameters
+    ----------
+    behaviors : list of BehaviorModel
+    min_probability : float
+        Outcomes less likely than this are not expanded by the search.
+    param_steps : int
+        Grid points per parameter of a parametric behaviour (chapter 9).
+    """
+
+    def __init__(self, behaviors: list[BehaviorModel], min_probability: float = 0.02, param_steps: int = 5):
+        self.behaviors = behaviors
+        self.names = [b.name for b in behaviors]
+        self.min_probability = min_probability
+        self.param_steps = param_steps
+        self._cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self.predictions = 0
+
+    def index(self, name: str) -> int:
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise ValueError(f"unknown behaviour {name!r}; the model knows {', '.join(self.names)}") from None
+
+    def alphas(self, b: int) -> list[tuple[float, ...]]:
+        """The parameter grid of behaviour ``b`` (one empty tuple for a behaviour without)."""
+        ranges = self.behaviors[b].parameters
+        if not ranges:
+            return [()]
+        axes = [np.linspace(lo, hi, self.param_steps) for lo, hi in ranges]
+        return [tuple(float(v) for v in p) for p in product(*axes)]
+
+    def distribution(self, f: np.ndarray, b: int, alpha: tuple = ()) -> tuple[np.ndarray, np.ndarray]:
+        """(categories, probabilities) of behaviour ``b`` on object vector ``f``."""
+        key = (b, f.tobytes(), alpha)
+        hit = self._cache.get(key)
+        if hit is None:
+            model = self.behaviors[b]
+            x = np.concatenate([f[model.selected], np.asarray(alpha, dtype=float)])[None, :]
+            proba = model.predictor.predict_proba(x)[0]
+            hit = (np.asarray(model.predictor.classes_, dtype=int), proba)
+            self._cache[key] = hit
+            self.predictions += 1
+        return hit
+
+    def apply(self, state: np.ndarray, obj: int, b: int, category: int) -> np.ndarray:
+        """The state after behaviour ``b`` on ``obj`` produced ``category``."""
+        nxt = state.copy()
+        f = state[obj] + self.behaviors[b].prototypes[category]
+        if f[0] < 0.5:  # vanished: the last seen features stay, visibility drops
+            nxt[obj, 0] = 0.0
+        else:
+            f[0] = 1.0
+            nxt[obj] = f
+        return nxt
+
+    def outcomes(self, state: np.ndarray, obj: int, b: int, alpha: tuple = ()) -> list[Outcome]:
+        """Likely outcomes (probability >= min_probability), most likely first."""
+        if state[obj, 0] < 0.5:
+            return []  # the robot cannot act on what it does not see
+        classes, proba = self.distribution(state[obj], b, alpha)
+        order = np.argsort(-proba, kind="stable")
+        return [Outcome(int(classes[i]), float(proba[i]), self.apply(state, obj, b, int(classes[i])))
+                for i in order if proba[i] >= self.min_probability]
+
+    def choose_alpha(self, f: np.ndarray, b: int, rule: str = "probable") -> tuple[tuple, int]:
+        """Chapter 9's parameter choice for one behaviour on one object.
+
+        ``"group"``: predict a category for every grid point, take the largest group of
+        points predicting the same category, and return the mean of its alphas.
+        ``"probable"``: the grid point whose predicted category is most probable.
+        """
+        grid = self.alphas(b)
+        preds = [self.distribution(f, b, a) for a in grid]
+        best = [(int(c[np.argmax(p)]), float(p.max())) for c, p in preds]
+        if rule == "group":
+            cats = [c for c, _ in best]
+            top = max(set(cats), key=lambda c: (cats.count(c), -c))
+            members = np.array([a for a, c in zip(grid, cats) if c == top])
+            return tuple(float(v) for v in members.mean(axis=0)) if members.size else (), top
+        i = int(np.argmax([p for _, p in best]))
+        return grid[i], best[i][0]

@@ -1,0 +1,132 @@
+"""Goals: constraints on perceived features (thesis chapter 8.6's {(o, i_f, v, r)}).
+
+An expression ``OBJ:FEATURE=VALUE~RANGE`` says: feature FEATURE of object OBJ must lie
+within RANGE of VALUE. OBJ is an object index, ``*`` (some object) or ``A-B`` (object A's
+feature minus object B's: a relative goal). Without ``~RANGE`` a default tolerance for the
+feature's channel applies. Several constraints must all hold.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from features import FeatureSchema
+
+__all__ = ["Constraint", "Goal", "parse_goal", "DEFAULT_TOLERANCE", "GoalError"]
+
+#: Default tolerance per channel, used where an expression gives no ``~RANGE``.
+DEFAULT_TOLERANCE = {"visibility": 0.5, "position": 0.05, "shape": 0.1}
+#: How far one unit of each channel counts in the search heuristic.
+SCALE = {"visibility": 1.0, "position": 0.1, "shape": 0.5}
+
+_EXPR = re.compile(r"^\s*(?P<obj>\*|\d+|\d+\s*-\s*\d+)\s*:\s*(?P<feat>[A-Za-z_][\w]*)\s*=\s*(?P<val>[-+]?[\d.eE+-]+)"
+                   r"\s*(~\s*(?P<rng>[\d.eE+-]+))?\s*$")
+
+
+class GoalError(ValueError):
+    """A goal expression that cannot be used."""
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """One constraint: ``obj`` is an index, ``"*"``, or a pair (a, b) for a relative goal."""
+
+    obj: int | str | tuple[int, int]
+    feature: int
+    name: str
+    value: float
+    tolerance: float
+    channel: str
+
+    def values(self, state: np.ndarray) -> np.ndarray:
+        """The constrained quantity for every object this constraint may be about."""
+        if self.obj == "*":
+            return state[:, self.feature]
+        if isinstance(self.obj, tuple):
+            a, b = self.obj
+            return np.array([state[a, self.feature] - state[b, self.feature]])
+        return np.array([state[self.obj, self.feature]])
+
+    def gaps(self, state: np.ndarray) -> np.ndarray:
+        """How far outside the tolerance each candidate lies (0 where it holds)."""
+        return np.maximum(np.abs(self.values(state) - self.value) - self.tolerance, 0.0)
+
+    def holds(self, state: np.ndarray) -> bool:
+        return bool((self.gaps(state) <= 1e-9).any())
+
+    def text(self) -> str:
+        obj = f"{self.obj[0]}-{self.obj[1]}" if isinstance(self.obj, tuple) else str(self.obj)
+        return f"{obj}:{self.name}={self.value:g}~{self.tolerance:g}"
+
+
+@dataclass(frozen=True)
+class Goal:
+    constraints: tuple[Constraint, ...]
+
+    def holds(self, state: np.ndarray) -> bool:
+        return all(c.holds(state) for c in self.constraints)
+
+    def distance(self, state: np.ndarray) -> float:
+        """Scaled distance to the goal: 0 exactly when it holds (the search heuristic)."""
+        return float(sum(c.gaps(state).min() / SCALE.get(c.channel, 1.0) for c in self.constraints))
+
+    @property
+    def channels(self) -> set[str]:
+        return {c.channel for c in self.constraints}
+
+    def objects(self) -> set[int]:
+        out: set[int] = set()
+        for c in self.constraints:
+            if isinstance(c.obj, tuple):
+                out.update(c.obj)
+            elif isinstance(c.obj, int):
+                out.add(c.obj)
+        return out
+
+    def check_objects(self, n: int) -> None:
+        for i in sorted(self.objects()):
+            if i >= n:
+                raise GoalError(f"the goal names object {i}, but the robot sees {n} object{'s' if n != 1 else ''} (0..{n - 1})")
+
+    def to_json(self) -> list[str]:
+        return [c.text() for c in self.constraints]
+
+
+def parse_goal(expressions: list[str], schema: FeatureSchema) -> Goal:
+    """Parse ``OBJ:FEATURE=VALUE~RANGE`` expressions; every mistake is one sentence."""
+    if not expressions:
+        raise GoalError("give at least one goal, e.g. '*:visibility=0'")
+    out = []
+    for expr in expressions:
+        m = _EXPR.match(expr)
+        if not m:
+            raise GoalError(f"cannot read goal {expr!r}; write OBJ:FEATURE=VALUE~RANGE, e.g. '0:z_min=0.95~0.03'")
+        try:
+            feature = schema.index(m["feat"])
+        except KeyError:
+            raise GoalError(f"goal {expr!r} names an unknown feature {m['feat']!r}; features are "
+                            f"{', '.join(schema.names[:7])}, ... (see 'afford inspect MODEL')") from None
+        obj_text = m["obj"].replace(" ", "")
+        if obj_text == "*":
+            obj: int | str | tuple[int, int] = "*"
+        elif "-" in obj_text:
+            a, b = (int(v) for v in obj_text.split("-"))
+            if a == b:
+                raise GoalError(f"goal {expr!r} relates object {a} to itself")
+            obj = (a, b)
+        else:
+            obj = int(obj_text)
+        try:
+            value = float(m["val"])
+            tol = float(m["rng"]) if m["rng"] is not None else None
+        except ValueError:
+            raise GoalError(f"goal {expr!r} has a value that is not a number") from None
+        channel = schema.channels[feature]
+        tol = DEFAULT_TOLERANCE.get(channel, 0.05) if tol is None else tol
+        if tol < 0 or not np.isfinite(value):
+            raise GoalError(f"goal {expr!r}: the value must be finite and the range not negative")
+        out.append(Constraint(obj, feature, schema.names[feature], value, tol, channel))
+    return Goal(tuple(out))

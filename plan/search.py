@@ -1,0 +1,189 @@
+"""Searching for behaviour sequences in the robot's perceptual space (thesis 7.5, 8.6).
+
+``best_first``: states are the lists of object vectors; an edge is (behaviour, object,
+alpha) together with one predicted outcome category, costing -log P(category). Nodes are
+popped in order of cost plus ``heuristic_weight`` times the goal distance (ties go to the
+node nearer the goal), so with the default weight of 0 the first plan that reaches the
+goal is the most probable one within the limits. ``breadth_first`` is the thesis's forward
+chaining: only each behaviour's most probable outcome, shortest plan first.
+
+A plan's *success probability* is the chance that executing its behaviours open-loop
+reaches the goal at some step, summed over every outcome sequence the model predicts (not
+only the one the plan was found along).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from plan.forward import ForwardModel
+from plan.goals import Goal
+
+__all__ = ["PlanStep", "Plan", "best_first", "breadth_first", "success_probability", "search"]
+
+
+@dataclass(frozen=True)
+class PlanStep:
+    behavior: str
+    obj: int
+    alpha: tuple
+    category: int
+    probability: float
+    predicted: np.ndarray  # the state expected after this step
+
+    def to_json(self) -> dict:
+        return {"behavior": self.behavior, "object": self.obj, "alpha": list(self.alpha),
+                "category": self.category, "probability": round(self.probability, 4)}
+
+
+@dataclass
+class Plan:
+    found: bool
+    steps: list[PlanStep] = field(default_factory=list)
+    path_probability: float = 0.0      # product of the step probabilities along the plan
+    success_probability: float = 0.0   # open-loop chance of reaching the goal
+    expanded: int = 0
+    generated: int = 0
+    seconds: float = 0.0
+    reason: str = ""
+    tree: list[dict] = field(default_factory=list)  # the first levels of the search, for reports
+
+    def to_json(self) -> dict:
+        return {"found": self.found, "steps": [s.to_json() for s in self.steps], "length": len(self.steps),
+                "path_probability": round(self.path_probability, 4),
+                "success_probability": round(self.success_probability, 4),
+                "expanded": self.expanded, "generated": self.generated, "seconds": round(self.seconds, 4),
+                "reason": self.reason}
+
+
+def _key(state: np.ndarray) -> bytes:
+    return np.round(state, 3).tobytes()
+
+
+def _actions(model: ForwardModel, state: np.ndarray):
+    for obj in range(state.shape[0]):
+        if state[obj, 0] < 0.5:
+            continue
+        for b in range(len(model.behaviors)):
+            for alpha in model.alphas(b):
+                yield b, obj, alpha
+
+
+def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4, max_nodes: int = 20000,
+               heuristic_weight: float = 0.0, exclude_first: frozenset = frozenset()) -> Plan:
+    """Most probable plan; ``exclude_first`` lists (behaviour, object) pairs not to start with."""
+    t0 = time.perf_counter()
+    if goal.holds(start):
+        return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
+    counter = 0
+    frontier = [(heuristic_weight * goal.distance(start), goal.distance(start), counter, 0.0, start, ())]
+    best_cost: dict[bytes, float] = {_key(start): 0.0}
+    expanded = generated = 0
+    tree: list[dict] = []
+    while frontier:
+        _, _, _, cost, state, steps = heapq.heappop(frontier)
+        if goal.holds(state):
+            plan = Plan(True, list(steps), math.exp(-cost), 0.0, expanded, generated, 0.0)
+            plan.success_probability = success_probability(model, start, goal, plan.steps)
+            plan.seconds = time.perf_counter() - t0
+            plan.tree = tree
+            return plan
+        if len(steps) >= max_depth:
+            continue
+        if expanded >= max_nodes:
+            return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
+                        f"node budget of {max_nodes} expansions spent", tree)
+        expanded += 1
+        for b, obj, alpha in _actions(model, state):
+            if not steps and (model.names[b], obj) in exclude_first:
+                continue
+            for out in model.outcomes(state, obj, b, alpha):
+                generated += 1
+                c = cost - math.log(max(out.probability, 1e-12))
+                k = _key(out.state)
+                if best_cost.get(k, math.inf) <= c + 1e-12:
+                    continue
+                best_cost[k] = c
+                step = PlanStep(model.names[b], obj, alpha, out.category, out.probability, out.state)
+                h = goal.distance(out.state)
+                if len(steps) < 1:
+                    tree.append({"depth": 1, **step.to_json(), "distance": round(h, 3)})
+                counter += 1
+                heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,)))
+    return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
+                f"no plan of at most {max_depth} steps reaches the goal", tree)
+
+
+def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4,
+                  max_nodes: int = 20000, exclude_first: frozenset = frozenset()) -> Plan:
+    """Forward chaining over each behaviour's most probable outcome (thesis chapter 7)."""
+    t0 = time.perf_counter()
+    if goal.holds(start):
+        return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
+    level = [(start, ())]
+    seen = {_key(start)}
+    expanded = generated = 0
+    for _ in range(max_depth):
+        nxt = []
+        for state, steps in level:
+            if expanded >= max_nodes:
+                return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
+                            f"node budget of {max_nodes} expansions spent")
+            expanded += 1
+            for b, obj, alpha in _actions(model, state):
+                if not steps and (model.names[b], obj) in exclude_first:
+                    continue
+                outs = model.outcomes(state, obj, b, alpha)
+                if not outs:
+                    continue
+                out = outs[0]
+                generated += 1
+                k = _key(out.state)
+                if k in seen:
+                    continue
+                seen.add(k)
+                new = steps + (PlanStep(model.names[b], obj, alpha, out.category, out.probability, out.state),)
+                if goal.holds(out.state):
+                    plan = Plan(True, list(new), float(np.prod([s.probability for s in new])), 0.0, expanded, generated)
+                    plan.success_probability = success_probability(model, start, goal, plan.steps)
+                    plan.seconds = time.perf_counter() - t0
+                    return plan
+                nxt.append((out.state, new))
+        level = nxt
+    return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
+                f"no plan of at most {max_depth} steps reaches the goal")
+
+
+def success_probability(model: ForwardModel, start: np.ndarray, goal: Goal, steps: list[PlanStep]) -> float:
+    """P(the goal holds after some step | the plan's behaviours run open-loop), by the model."""
+
+    def walk(state: np.ndarray, i: int) -> float:
+        if goal.holds(state):
+            return 1.0
+        if i == len(steps):
+            return 0.0
+        s = steps[i]
+        b = model.index(s.behavior)
+        if state[s.obj, 0] < 0.5:
+            return 0.0
+        classes, proba = model.distribution(state[s.obj], b, s.alpha)
+        total = 0.0
+        for c, p in zip(classes, proba):
+            if p < 1e-4:
+                continue
+            total += p * walk(model.apply(state, s.obj, b, int(c)), i + 1)
+        return total
+
+    return float(min(1.0, walk(start, 0)))
+
+
+def search(model: ForwardModel, start: np.ndarray, goal: Goal, method: str = "best-first", **limits) -> Plan:
+    if method == "bfs":
+        limits.pop("heuristic_weight", None)
+        return breadth_first(model, start, goal, **limits)
+    return best_first(model, start, goal, **limits)
