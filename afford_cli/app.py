@@ -14,7 +14,9 @@ from typing import Callable
 
 import typer
 
-from afford_cli.commands import cluster, demo, evaluate, explore, inspect, plan, predict, scenes, select_features, train
+from afford_cli.commands import (
+    cluster, demo, emulate, evaluate, explore, inspect, plan, predict, scenes, select_features, train,
+)
 from afford_cli.errors import AffordError
 
 app = typer.Typer(
@@ -46,7 +48,7 @@ def _guarded(command: Callable) -> Callable:
 for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore), ("cluster", cluster.cluster),
                         ("select-features", select_features.select_features), ("train", train.train),
                         ("evaluate", evaluate.evaluate), ("predict", predict.predict),
-                        ("plan", plan.plan),
+                        ("plan", plan.plan), ("emulate", emulate.emulate),
                         ("inspect", inspect.inspect), ("demo", demo.demo)):
     app.command(_name)(_guarded(_command))
 

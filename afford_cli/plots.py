@@ -57,7 +57,7 @@ def plot_directory(path: str | Path) -> Path:
 
 
 def written(paths: list[str]) -> str:
-    """The stderr line listing the figures a command wrote."""
+    """What a command tells stderr about its figures: one path a line (escaped: rich reads markup)."""
     from rich.markup import escape
 
     if not paths:
@@ -213,7 +213,7 @@ def relevance_figure(path: Path, behavior: str, scores: dict | None, selected: l
         values = [v for _, v in ranked]
         below = len(chosen - set(names))
         title = (f"{behavior}: feature relevance, top {len(names)} of {len(scores)}"
-                 f" ({len(chosen)} selected" + (f", {below} of them below these" if below else "") + ")")
+                 f" ({len(chosen)} selected" + (f", {below} of them not shown" if below else "") + ")")
         xlabel = "relevance score"
     else:
         names = list(selected)
@@ -235,7 +235,7 @@ def relevance_figure(path: Path, behavior: str, scores: dict | None, selected: l
         ax.spines[side].set_visible(False)
     if scores:
         ax.legend(handles=[Patch(color=_SELECTED, label="selected"), Patch(color=_OTHER, label="not selected")],
-                  fontsize=8, loc="lower right", frameon=False)
+                  fontsize=8, loc="best", frameon=False)
     ax.set_title(title, fontsize=10)
     return _save(fig, path)
 

@@ -9,7 +9,8 @@ from afford_cli.errors import AffordError
 __all__ = ["scene_objects", "open_world"]
 
 
-def scene_objects(scene_name: str, seed: int | None, objects: int, layout: str | None, reachable: bool = False):
+def scene_objects(scene_name: str, seed: int | None, objects: int, layout: str | None, reachable: bool = False,
+                  allow_empty: bool = False):
     """The scene and its objects, from a layout file or drawn from the seed."""
     from afford_cli.commands.explore import make_scene
     from sim.layout import LayoutError, load_layout
@@ -20,6 +21,8 @@ def scene_objects(scene_name: str, seed: int | None, objects: int, layout: str |
             specs = load_layout(layout)
         except LayoutError as exc:
             raise AffordError(str(exc)) from None
+        if not specs and not allow_empty:
+            raise AffordError(f"{layout} has no [[object]] entries; the robot needs something to act on")
     else:
         if seed is None:
             raise AffordError("give --layout FILE, or --seed S to draw a random scene")

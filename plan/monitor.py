@@ -5,8 +5,8 @@ simulator implements (``sim.session.SimWorld``); ``plan`` never imports ``sim``.
 keeps track of which perceived object is which, so a step's prediction is compared with
 the perception of the same objects. When a perceived outcome differs from the predicted one
 on the goal's channels, the robot replans from what it perceives, up to ``max_replans`` times,
-and does not open the new plan with a behaviour that just failed on an object that has not
-moved since (the same prediction would send it round in circles).
+and the new plan may not use a behaviour that already failed on that object in the same
+situation (the same prediction would send it round in circles).
 """
 
 from __future__ import annotations
@@ -20,10 +20,7 @@ from plan.forward import ForwardModel
 from plan.goals import DEFAULT_TOLERANCE, Goal
 from plan.search import Plan, search
 
-__all__ = ["World", "Execution", "execute", "mismatch", "MOVED"]
-
-#: An object whose position features changed less than this (metres) has not moved.
-MOVED = 0.015
+__all__ = ["World", "Execution", "execute", "mismatch"]
 
 
 class World(Protocol):
@@ -98,9 +95,7 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             run.reason = f"gave up after {run.replans} replans ({surprised})"
             return run
         run.replans += 1
-        # Do not open the new plan with a behaviour that just surprised the robot on an
-        # object that has not changed since: replanning would only repeat it.
-        avoid = frozenset((b, i) for f, b, i in failed
-                          if i < state.shape[0] and np.abs(state[i, 1:7] - f[1:7]).max() < MOVED)
-        plan = search(model, state, goal, method, exclude_first=avoid, **limits)
+        # The new plan may not use a behaviour that already surprised the robot on an object
+        # in the same situation: the model would predict the same, and the robot repeat it.
+        plan = search(model, state, goal, method, avoid=tuple(failed), **limits)
         run.plans.append(plan)

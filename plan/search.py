@@ -24,7 +24,7 @@ import numpy as np
 from plan.forward import ForwardModel
 from plan.goals import Goal
 
-__all__ = ["PlanStep", "Plan", "best_first", "breadth_first", "success_probability", "search"]
+__all__ = ["PlanStep", "Plan", "best_first", "breadth_first", "success_probability", "search", "SAME_PLACE"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +65,23 @@ def _key(state: np.ndarray) -> bytes:
     return np.round(state, 3).tobytes()
 
 
+#: Two situations of an object closer than this (metres, every position feature) are the same.
+SAME_PLACE = 0.05
+#: Extra search cost (nats) of a behaviour for each time it surprised the robot on that object
+#: elsewhere: the model erred there once, so the planner trusts it half as much.
+DISTRUST = math.log(2.0)
+
+
+def _avoided(avoid: tuple, state: np.ndarray, behavior: str, obj: int) -> bool:
+    """Did ``behavior`` on ``obj`` already fail with the object in this situation?
+
+    ``avoid`` holds (object features before, behaviour, object) of steps whose outcome
+    surprised the robot during execution; the model would predict the same again.
+    """
+    f = state[obj, 1:7]
+    return any(b == behavior and i == obj and np.abs(f - g[1:7]).max() < SAME_PLACE for g, b, i in avoid)
+
+
 def _actions(model: ForwardModel, state: np.ndarray):
     for obj in range(state.shape[0]):
         if state[obj, 0] < 0.5:
@@ -75,8 +92,14 @@ def _actions(model: ForwardModel, state: np.ndarray):
 
 
 def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4, max_nodes: int = 20000,
-               heuristic_weight: float = 0.0, exclude_first: frozenset = frozenset()) -> Plan:
-    """Most probable plan; ``exclude_first`` lists (behaviour, object) pairs not to start with."""
+               heuristic_weight: float = 0.0, avoid: tuple = ()) -> Plan:
+    """Most probable plan.
+
+    ``avoid`` lists steps that surprised the robot during execution, as (object features
+    before, behaviour, object): such a behaviour is not tried again on that object in the
+    same situation, and elsewhere on that object it costs DISTRUST more per surprise. The
+    plan's probabilities stay the model's; only the order of the search changes.
+    """
     t0 = time.perf_counter()
     if goal.holds(start):
         return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
@@ -100,11 +123,14 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                         f"node budget of {max_nodes} expansions spent", tree)
         expanded += 1
         for b, obj, alpha in _actions(model, state):
-            if not steps and (model.names[b], obj) in exclude_first:
-                continue
+            penalty = 0.0
+            if avoid:
+                if _avoided(avoid, state, model.names[b], obj):
+                    continue
+                penalty = DISTRUST * sum(1 for _, bb, i in avoid if bb == model.names[b] and i == obj)
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
-                c = cost - math.log(max(out.probability, 1e-12))
+                c = cost - math.log(max(out.probability, 1e-12)) + penalty
                 k = _key(out.state)
                 if best_cost.get(k, math.inf) <= c + 1e-12:
                     continue
@@ -120,7 +146,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
 
 
 def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4,
-                  max_nodes: int = 20000, exclude_first: frozenset = frozenset()) -> Plan:
+                  max_nodes: int = 20000, avoid: tuple = ()) -> Plan:
     """Forward chaining over each behaviour's most probable outcome (thesis chapter 7)."""
     t0 = time.perf_counter()
     if goal.holds(start):
@@ -136,7 +162,7 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
             for b, obj, alpha in _actions(model, state):
-                if not steps and (model.names[b], obj) in exclude_first:
+                if avoid and _avoided(avoid, state, model.names[b], obj):
                     continue
                 outs = model.outcomes(state, obj, b, alpha)
                 if not outs:

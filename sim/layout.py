@@ -35,7 +35,7 @@ def _numbers(value, what: str, where: str) -> tuple[float, ...]:
 
 
 def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
-    """Objects of a layout given as TOML text."""
+    """Objects of a layout given as TOML text (an empty layout is an empty table)."""
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -44,8 +44,8 @@ def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
     if unknown_top:
         raise LayoutError(f"{source}: unknown table {sorted(unknown_top)[0]!r}; a layout holds [[object]] entries")
     items = doc.get("object", [])
-    if not isinstance(items, list) or not items:
-        raise LayoutError(f"{source} has no [[object]] entries")
+    if not isinstance(items, list):
+        raise LayoutError(f"{source}: 'object' must be a list of [[object]] tables")
     specs = []
     for i, item in enumerate(items):
         where = f"{source}, object {i}"

@@ -98,3 +98,13 @@ def test_track_keeps_a_vanished_object_with_visibility_zero():
     out = track(known, moved_b[None, :])
     assert out[0, 0] == 0 and np.allclose(out[0, 1:], a[1:])  # a gone, last seen kept
     assert np.allclose(out[1], moved_b)
+
+
+def test_track_prefers_a_visible_object_over_a_vanished_one():
+    schema = object_schema()
+    gone = np.zeros(len(schema)); gone[1:7] = [0.6, 0.7, 0.0, 0.1, 0.75, 0.85]           # visibility 0
+    held = np.zeros(len(schema)); held[0] = 1; held[1:7] = [0.6, 0.7, 0.05, 0.15, 0.95, 1.05]  # up in the hand
+    dropped = held.copy(); dropped[5:7] = [0.75, 0.85]  # it fell back, right where the other vanished
+    out = track(np.stack([gone, held]), dropped[None, :])
+    assert out[0, 0] == 0 and out[1, 0] == 1
+    assert np.allclose(out[1], dropped)

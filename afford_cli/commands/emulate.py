@@ -1,0 +1,63 @@
+"""``afford emulate``: be shown a scene, derive the goal, reach it from another scene."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+import typer
+
+from afford_cli.commands.plan import render_plan
+from afford_cli.errors import AffordError
+from afford_cli.learning import forward_model, load_model
+from afford_cli.options import Json, SceneName
+from afford_cli.output import Output
+from afford_cli.scenes_io import open_world, scene_objects
+
+
+def emulate(
+    model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
+    observe: Annotated[str, typer.Option("--observe", help="Layout of the scene the robot is shown (the goal).")],
+    start: Annotated[str, typer.Option("--start", help="Layout of the scene the robot starts from.")],
+    scene: SceneName = "table",
+    execute: Annotated[bool, typer.Option("--execute/--no-execute", help="Run the plan in the simulator with monitoring.")] = True,
+    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8)] = 4,
+    max_nodes: Annotated[int, typer.Option("--max-nodes", min=1)] = 20000,
+    max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
+    seed: Annotated[int, typer.Option("--seed", "-s", min=0, help="Seed of the simulated worlds (noise).")] = 0,
+    json: Json = False,
+) -> None:
+    """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
+    from plan.emulate import goal_from_observation
+    from plan.monitor import execute as run
+    from plan.search import search
+
+    loaded = load_model(model)
+    fm = forward_model(loaded)
+    sc, shown = scene_objects(scene, None, 1, observe, allow_empty=True)
+    _, specs = scene_objects(scene, None, 1, start)
+    observed = open_world(sc, shown, seed).perceive() if shown else np.empty((0, len(loaded.schema)))
+    world = open_world(sc, specs, seed + 1)
+    state = world.perceive()
+    loaded.check_schema(sc.schema, "this scene's perception")
+    try:
+        goal = goal_from_observation(observed, state, loaded.schema)
+    except ValueError as exc:
+        raise AffordError(str(exc)) from None
+    plan = search(fm, state, goal, "best-first", max_depth=max_depth, max_nodes=max_nodes)
+    result = {"goal": goal.to_json(), "plan": plan.to_json()["steps"], "found": plan.found,
+              "success_probability": round(plan.success_probability, 4), "reached": False, "replans": 0,
+              "search": plan.to_json()}
+    entry = {"plan": plan.to_json(), "tree": plan.tree[:8]}
+    if execute and plan.found:
+        ex = run(world, fm, goal, max_replans=max_replans, first=plan, max_depth=max_depth, max_nodes=max_nodes)
+        result.update({"reached": ex.reached, "replans": ex.replans, "execution": ex.to_json()})
+        entry["execution"] = ex.to_json()
+    elif not plan.found:
+        result["reason"] = plan.reason
+
+    def render(console):
+        console.print(f"shown: {len(shown)} object(s); derived goal: {' and '.join(goal.to_json())}")
+        render_plan(console, entry, goal.to_json())
+
+    Output(json).result(result, render)
