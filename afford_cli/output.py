@@ -43,7 +43,7 @@ class Output:
         self.err.print(f"[yellow]warning:[/] {message}")
 
     def info(self, message: str) -> None:
-        self.err.print(message)
+        self.err.print(message, soft_wrap=True)
 
     @contextmanager
     def progress(self, description: str, total: int) -> Iterator[Callable[[int], None]]:

@@ -17,7 +17,7 @@ from sklearn.utils import check_random_state
 
 from learn.xmeans import _check_finite
 
-__all__ = ["baseline_scores", "evaluate_predictions"]
+__all__ = ["baseline_scores", "evaluate_predictions", "reliability_bins"]
 
 
 def _plain(v):
@@ -47,7 +47,8 @@ def evaluate_predictions(y_true, proba, classes, n_bins=10, eps=1e-15) -> dict:
         ``brier`` (mean over rows of the squared error between the one-hot truth and the
         probabilities, summed over classes: 0 is perfect, 2 the worst; a row of an unseen
         category adds 1 for its missing column); ``ece`` (expected calibration error of the
-        top-class confidence: bin-size-weighted mean of |accuracy - mean confidence|);
+        top-class confidence: bin-size-weighted mean of |accuracy - mean confidence| over the
+        bins of :func:`reliability_bins`);
         ``labels`` (known classes, then unseen true labels, in order of appearance) and
         ``confusion_matrix`` (rows: true label, columns: predicted label, over ``labels``);
         ``n_unseen`` (rows whose category is not in ``classes``).
@@ -58,23 +59,10 @@ def evaluate_predictions(y_true, proba, classes, n_bins=10, eps=1e-15) -> dict:
     >>> round(r["accuracy"], 3), round(r["brier"], 3)
     (1.0, 0.2)
     """
-    y_true = np.asarray(y_true)
-    proba = np.asarray(proba, dtype=np.float64)
-    classes = np.asarray(classes)
-    if proba.ndim != 2 or proba.shape != (y_true.shape[0], classes.shape[0]):
-        raise ValueError(
-            f"proba must have one row per label and one column per class: got shape {proba.shape} "
-            f"for {y_true.shape[0]} labels and {classes.shape[0]} classes."
-        )
-    if y_true.shape[0] == 0:
-        raise ValueError("there is nothing to evaluate: y_true is empty.")
-    _check_finite(proba, "proba")
+    y_true, proba, classes = _check_predictions(y_true, proba, classes)
     n = y_true.shape[0]
-    known = {c: j for j, c in enumerate(classes.tolist())}
-    col = np.array([known.get(v, -1) for v in y_true.tolist()])
+    known, col, top, correct = _top_class(y_true, proba, classes)
     seen = col >= 0
-    top = np.argmax(proba, axis=1)
-    correct = seen & (top == col)
 
     p_true = np.where(seen, proba[np.arange(n), np.where(seen, col, 0)], 0.0)
     log_loss = float(np.mean(-np.log(np.clip(p_true, eps, 1.0))))
@@ -82,13 +70,8 @@ def evaluate_predictions(y_true, proba, classes, n_bins=10, eps=1e-15) -> dict:
     onehot[np.flatnonzero(seen), col[seen]] = 1.0
     brier = float(np.mean(((proba - onehot) ** 2).sum(axis=1) + (~seen)))
 
-    confidence = proba[np.arange(n), top]
-    bins = np.minimum((confidence * n_bins).astype(int), n_bins - 1)
-    ece = 0.0
-    for b in range(n_bins):
-        in_bin = bins == b
-        if in_bin.any():
-            ece += in_bin.mean() * abs(correct[in_bin].mean() - confidence[in_bin].mean())
+    bins = _calibration_bins(proba[np.arange(n), top], correct, n_bins)
+    ece = sum(b["count"] / n * abs(b["accuracy"] - b["confidence"]) for b in bins)
 
     labels = classes.tolist() + [v for v in dict.fromkeys(y_true.tolist()) if v not in known]
     index = {v: i for i, v in enumerate(labels)}
@@ -104,6 +87,77 @@ def evaluate_predictions(y_true, proba, classes, n_bins=10, eps=1e-15) -> dict:
         "confusion_matrix": confusion.tolist(),
         "n_unseen": int((~seen).sum()),
     }
+
+
+def reliability_bins(y_true, proba, classes, n_bins=10) -> list[dict]:
+    """The reliability diagram of the top-class confidence, bin by bin.
+
+    Rows are binned by the probability of their most probable class into ``n_bins``
+    equal-width bins of [0, 1] (closed on the left; the last bin also holds 1.0), the bins
+    :func:`evaluate_predictions` computes its ``ece`` over. A row whose true category is
+    not in ``classes`` counts as wrong.
+
+    Parameters
+    ----------
+    y_true : array-like of shape (n_samples,)
+    proba : array-like of shape (n_samples, n_classes)
+        Predicted probabilities; column ``j`` belongs to ``classes[j]``.
+    classes : array-like of shape (n_classes,)
+    n_bins : int, default=10
+
+    Returns
+    -------
+    list of dict
+        One ``{"confidence", "accuracy", "count"}`` per non-empty bin, in increasing
+        confidence: the bin's mean top-class probability, the fraction of its rows whose
+        top class is the truth, and how many rows fell into it.
+
+    Examples
+    --------
+    >>> bins = reliability_bins([0, 1, 1], [[0.9, 0.1], [0.95, 0.05], [0.35, 0.65]], [0, 1])
+    >>> [(round(b["confidence"], 3), b["accuracy"], b["count"]) for b in bins]
+    [(0.65, 1.0, 1), (0.925, 0.5, 2)]
+    """
+    y_true, proba, classes = _check_predictions(y_true, proba, classes)
+    _, _, top, correct = _top_class(y_true, proba, classes)
+    return _calibration_bins(proba[np.arange(y_true.shape[0]), top], correct, n_bins)
+
+
+def _check_predictions(y_true, proba, classes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    y_true = np.asarray(y_true)
+    proba = np.asarray(proba, dtype=np.float64)
+    classes = np.asarray(classes)
+    if proba.ndim != 2 or proba.shape != (y_true.shape[0], classes.shape[0]):
+        raise ValueError(
+            f"proba must have one row per label and one column per class: got shape {proba.shape} "
+            f"for {y_true.shape[0]} labels and {classes.shape[0]} classes."
+        )
+    if y_true.shape[0] == 0:
+        raise ValueError("there is nothing to evaluate: y_true is empty.")
+    _check_finite(proba, "proba")
+    return y_true, proba, classes
+
+
+def _top_class(y_true, proba, classes):
+    """Column of each row's truth (-1: unseen), the top column, and whether it is right."""
+    known = {c: j for j, c in enumerate(classes.tolist())}
+    col = np.array([known.get(v, -1) for v in y_true.tolist()])
+    top = np.argmax(proba, axis=1)
+    return known, col, top, (col >= 0) & (top == col)
+
+
+def _calibration_bins(confidence: np.ndarray, correct: np.ndarray, n_bins: int) -> list[dict]:
+    if int(n_bins) != n_bins or n_bins < 1:
+        raise ValueError(f"n_bins must be a positive integer, got {n_bins!r}.")
+    n_bins = int(n_bins)
+    index = np.clip((confidence * n_bins).astype(int), 0, n_bins - 1)
+    out = []
+    for b in range(n_bins):
+        in_bin = index == b
+        if in_bin.any():
+            out.append({"confidence": float(confidence[in_bin].mean()),
+                        "accuracy": float(correct[in_bin].mean()), "count": int(in_bin.sum())})
+    return out
 
 
 def baseline_scores(X_train, y_train, X_test, y_test, random_state=None) -> dict:
