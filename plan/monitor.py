@@ -5,8 +5,8 @@ simulator implements (``sim.session.SimWorld``); ``plan`` never imports ``sim``.
 keeps track of which perceived object is which, so a step's prediction is compared with
 the perception of the same objects. When a perceived outcome differs from the predicted one
 on the goal's channels, the robot replans from what it perceives, up to ``max_replans`` times,
-and the new plan may not use a behaviour that already failed on that object in the same
-situation (the same prediction would send it round in circles).
+and a behaviour that already surprised it on an object costs more in the new search (the same
+prediction would otherwise send it round in circles).
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             run.reason = f"gave up after {run.replans} replans ({surprised})"
             return run
         run.replans += 1
-        # The new plan may not use a behaviour that already surprised the robot on an object
-        # in the same situation: the model would predict the same, and the robot repeat it.
+        # Behaviours that surprised the robot cost more in the new search: the model would
+        # predict the same again, and the robot go round in circles.
         plan = search(model, state, goal, method, avoid=tuple(failed), **limits)
         run.plans.append(plan)

@@ -24,7 +24,7 @@ import numpy as np
 from plan.forward import ForwardModel
 from plan.goals import Goal
 
-__all__ = ["PlanStep", "Plan", "best_first", "breadth_first", "success_probability", "search", "SAME_PLACE"]
+__all__ = ["PlanStep", "Plan", "best_first", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE"]
 
 
 @dataclass(frozen=True)
@@ -72,14 +72,20 @@ SAME_PLACE = 0.05
 DISTRUST = math.log(2.0)
 
 
-def _avoided(avoid: tuple, state: np.ndarray, behavior: str, obj: int) -> bool:
-    """Did ``behavior`` on ``obj`` already fail with the object in this situation?
+def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int) -> float:
+    """Extra search cost of ``behavior`` on ``obj`` after it surprised the robot.
 
     ``avoid`` holds (object features before, behaviour, object) of steps whose outcome
-    surprised the robot during execution; the model would predict the same again.
+    surprised the robot during execution. Each such surprise costs 2 * DISTRUST where the
+    object is in the same situation again (within SAME_PLACE) and DISTRUST elsewhere: the
+    model erred there, and would predict the same again.
     """
     f = state[obj, 1:7]
-    return any(b == behavior and i == obj and np.abs(f - g[1:7]).max() < SAME_PLACE for g, b, i in avoid)
+    cost = 0.0
+    for g, b, i in avoid:
+        if b == behavior and i == obj:
+            cost += 2 * DISTRUST if np.abs(f - g[1:7]).max() < SAME_PLACE else DISTRUST
+    return cost
 
 
 def _actions(model: ForwardModel, state: np.ndarray):
@@ -95,10 +101,10 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                heuristic_weight: float = 0.0, avoid: tuple = ()) -> Plan:
     """Most probable plan.
 
-    ``avoid`` lists steps that surprised the robot during execution, as (object features
-    before, behaviour, object): such a behaviour is not tried again on that object in the
-    same situation, and elsewhere on that object it costs DISTRUST more per surprise. The
-    plan's probabilities stay the model's; only the order of the search changes.
+    ``avoid`` lists steps that surprised the robot during execution (see :func:`_distrust`):
+    they cost more, so the search tries something else first, yet a behaviour that is the
+    only way left is still used. The plan's probabilities stay the model's; only the order
+    of the search changes.
     """
     t0 = time.perf_counter()
     if goal.holds(start):
@@ -123,11 +129,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                         f"node budget of {max_nodes} expansions spent", tree)
         expanded += 1
         for b, obj, alpha in _actions(model, state):
-            penalty = 0.0
-            if avoid:
-                if _avoided(avoid, state, model.names[b], obj):
-                    continue
-                penalty = DISTRUST * sum(1 for _, bb, i in avoid if bb == model.names[b] and i == obj)
+            penalty = _distrust(avoid, state, model.names[b], obj) if avoid else 0.0
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
                 c = cost - math.log(max(out.probability, 1e-12)) + penalty
@@ -162,8 +164,8 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
             for b, obj, alpha in _actions(model, state):
-                if avoid and _avoided(avoid, state, model.names[b], obj):
-                    continue
+                if avoid and _distrust(avoid, state, model.names[b], obj) >= 2 * DISTRUST:
+                    continue  # chaining has no costs: a step that failed here is simply not retried
                 outs = model.outcomes(state, obj, b, alpha)
                 if not outs:
                     continue
@@ -213,3 +215,18 @@ def search(model: ForwardModel, start: np.ndarray, goal: Goal, method: str = "be
         limits.pop("heuristic_weight", None)
         return breadth_first(model, start, goal, **limits)
     return best_first(model, start, goal, **limits)
+
+
+def inverse_query(model: ForwardModel, state: np.ndarray, goal: Goal) -> list[dict]:
+    """Rank every (object, behaviour, alpha) by the probability that one step makes ``goal`` hold.
+
+    The thesis names this question, "which behaviour, with which parameter, most likely
+    produces this effect on this object?", as its most valuable missing piece (12.2).
+    """
+    ranked = []
+    for b, obj, alpha in _actions(model, state):
+        classes, proba = model.distribution(state[obj], b, alpha)
+        p = sum(float(pr) for c, pr in zip(classes, proba) if goal.holds(model.apply(state, obj, b, int(c))))
+        ranked.append({"object": obj, "behavior": model.names[b], "alpha": list(alpha), "probability": round(p, 4)})
+    ranked.sort(key=lambda r: (-r["probability"], r["object"], r["behavior"]))
+    return ranked

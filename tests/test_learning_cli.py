@@ -160,3 +160,47 @@ def test_clear_errors(pipeline, tmp_path):
     assert "needs 'interactions'" in _err(["evaluate", str(pipeline / "model.afford"), str(pipeline / "effects.afford")])
     assert "needs 'effects' or 'features'" in _err(["train", str(pipeline / "train.afford"), "-o", str(tmp_path / "x")])
     assert not (tmp_path / "x").exists()
+
+
+def test_plan_and_execute_in_simulation(pipeline):
+    out = json.loads(ok(["plan", str(pipeline / "model.afford"), "--seed", "3", "--reachable",
+                         "--goal", "*:visibility=0", "--execute", "--json"]).stdout)
+    assert out["goal"] == ["*:visibility=0~0.5"]
+    assert out["plan"]["found"]
+    assert 0 < out["plan"]["success_probability"] <= 1
+    assert all({"behavior", "object", "alpha", "probability"} <= set(s) for s in out["plan"]["steps"])
+    assert isinstance(out["reached"], bool) and out["replans"] >= 0
+    if out["reached"]:  # then the object really is gone
+        assert out["execution"]["executed"]
+
+
+def test_plan_episodes_report_rates(pipeline):
+    out = json.loads(ok(["plan", str(pipeline / "model.afford"), "--seed", "10", "--episodes", "4", "--reachable",
+                         "--goal", "*:visibility=0", "--execute", "--json"]).stdout)
+    assert out["episodes"] == 4
+    assert out["found"] == sum(v["found"] for v in out["by_length"].values())
+    assert out["reached"] == sum(v["reached"] for v in out["by_length"].values())
+    assert 0 <= out["mean_success_probability"] <= 1
+
+
+def test_plan_refuses_bad_goals(pipeline):
+    assert "unknown feature 'colour'" in _err(["plan", str(pipeline / "model.afford"), "--seed", "1", "--goal", "0:colour=1"])
+    assert "robot sees" in _err(["plan", str(pipeline / "model.afford"), "--seed", "1", "--goal", "5:visibility=0"])
+
+
+def test_emulate_an_empty_table(pipeline):
+    from pathlib import Path
+
+    layouts = Path(__file__).resolve().parents[1] / "examples" / "layouts"
+    out = json.loads(ok(["emulate", str(pipeline / "model.afford"), "--observe", str(layouts / "empty-table.toml"),
+                         "--start", str(layouts / "lift-start-1.toml"), "--json"]).stdout)
+    assert out["goal"] == ["0:visibility=0~0.5"]
+    assert {"plan", "success_probability", "reached", "replans"} <= set(out)
+
+
+def test_predict_answers_inverse_queries(pipeline):
+    out = json.loads(ok(["predict", str(pipeline / "model.afford"), "--seed", "4", "--objects", "2",
+                         "--want", "*:visibility=0", "--json"]).stdout)
+    probs = [r["probability"] for r in out["ranking"]]
+    assert len(probs) == 8 and probs == sorted(probs, reverse=True)
+    assert all(0 <= p <= 1 for p in probs)

@@ -70,6 +70,7 @@ def predict(
     objects: Annotated[int, typer.Option("--objects", min=1, max=6, help="Objects in a drawn scene.")] = 1,
     layout: Annotated[Optional[str], typer.Option("--layout", help="A TOML layout file that pins the scene.")] = None,
     run_check: Annotated[bool, typer.Option("--check", help="Also run each behaviour in the simulator and report whether the prediction held.")] = False,
+    want: Annotated[Optional[list[str]], typer.Option("--want", help="Inverse query: rank (object, behaviour, alpha) by the probability that one step makes OBJ:FEATURE=VALUE~RANGE hold.")] = None,
     json: Json = False,
 ) -> None:
     """Predict, for every object the robot sees, what each behaviour would do to it."""
@@ -84,6 +85,15 @@ def predict(
     if run_check:
         check(loaded, sc, specs, seed or 0, preds)
     result = {"objects": preds, "layout": [s.to_dict() for s in specs]}
+    if want:
+        from afford_cli.commands.plan import parse_goals
+        from afford_cli.learning import forward_model
+        from plan.search import inverse_query
+
+        goal = parse_goals(want, loaded.schema)
+        goal.check_objects(state.shape[0])
+        result["want"] = goal.to_json()
+        result["ranking"] = inverse_query(forward_model(loaded, min_probability=0.0), state, goal)
     if run_check:
         checks = [p["held"] for e in preds for p in e["behaviors"].values()]
         result["held"] = int(sum(checks))
@@ -112,5 +122,12 @@ def predict(
             console.print(t)
         if run_check:
             console.print(f"predictions held in {result['held']} of {result['checked']} runs")
+        if want:
+            t = Table(title=f"most likely to make {' and '.join(result['want'])} hold in one step", box=box.SIMPLE_HEAD)
+            for col in ("object", "behaviour", "alpha", "probability"):
+                t.add_column(col)
+            for r in result["ranking"][:10]:
+                t.add_row(str(r["object"]), r["behavior"], ", ".join(f"{a:.2f}" for a in r["alpha"]) or "-", f"{r['probability']:.3f}")
+            console.print(t)
 
     Output(json).result(result, render)

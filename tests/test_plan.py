@@ -1,0 +1,196 @@
+"""Planning on hand-made forward models: search, limits, goals, monitoring, emulation."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from features import object_schema
+from plan.emulate import goal_from_observation
+from plan.forward import BehaviorModel, ForwardModel
+from plan.goals import GoalError, parse_goal
+from plan.monitor import execute
+from plan.search import best_first, breadth_first, inverse_query, success_probability
+
+SCHEMA = object_schema()
+D = len(SCHEMA)
+X_MIN, X_MAX = SCHEMA.index("x_min"), SCHEMA.index("x_max")
+
+
+class Fixed:
+    """A 'predictor' with the same probabilities everywhere."""
+
+    def __init__(self, probs):
+        self.classes_ = np.arange(len(probs))
+        self.p = np.asarray(probs, dtype=float)
+
+    def predict_proba(self, X):
+        return np.tile(self.p, (len(X), 1))
+
+
+def effect(dx=0.0, vanish=False):
+    e = np.zeros(D)
+    e[X_MIN] = e[X_MAX] = dx
+    if vanish:
+        e[0] = -1.0
+    return e
+
+
+def behaviour(name, outcomes):
+    """outcomes: list of (probability, effect vector)."""
+    return BehaviorModel(name, Fixed([p for p, _ in outcomes]), np.array([0]), np.stack([e for _, e in outcomes]))
+
+
+def obj(x=0.0):
+    f = np.zeros(D)
+    f[0] = 1.0
+    f[X_MIN], f[X_MAX] = x, x + 0.1
+    return f
+
+
+def scene(*xs):
+    return np.stack([obj(x) for x in xs])
+
+
+NUDGE = behaviour("nudge", [(1.0, effect(0.1))])
+PUSH = behaviour("push", [(0.9, effect(0.2)), (0.1, effect())])
+THROW = behaviour("throw", [(0.5, effect(vanish=True)), (0.5, effect())])
+SWEEP = behaviour("sweep", [(0.9, effect(vanish=True)), (0.1, effect(0.05))])
+
+
+def goal(*exprs):
+    return parse_goal(list(exprs), SCHEMA)
+
+
+def test_breadth_first_finds_the_shortest_plan_best_first_the_most_probable():
+    fm = ForwardModel([NUDGE, PUSH])
+    g = goal("0:x_min=0.4~0.01")
+    short = breadth_first(fm, scene(0.0), g, max_depth=4)
+    assert [s.behavior for s in short.steps] == ["push", "push"]
+    probable = best_first(fm, scene(0.0), g, max_depth=4)
+    assert [s.behavior for s in probable.steps] == ["nudge"] * 4
+    assert probable.path_probability == pytest.approx(1.0)
+    assert short.path_probability == pytest.approx(0.81)
+
+
+def test_best_first_prefers_the_more_probable_of_two_plans():
+    fm = ForwardModel([THROW, SWEEP])
+    plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
+    assert [s.behavior for s in plan.steps] == ["sweep"]
+    assert plan.success_probability == pytest.approx(0.9)
+
+
+def test_depth_and_node_limits_are_respected():
+    fm = ForwardModel([NUDGE])
+    g = goal("0:x_min=0.3~0.01")
+    assert best_first(fm, scene(0.0), g, max_depth=3).found
+    shallow = best_first(fm, scene(0.0), g, max_depth=2)
+    assert not shallow.found and "at most 2 steps" in shallow.reason
+    starved = best_first(fm, scene(0.0), g, max_depth=5, max_nodes=2)
+    assert not starved.found and "node budget" in starved.reason and starved.expanded == 2
+
+
+def test_any_object_goal_acts_on_whichever_object_works_best():
+    fm = ForwardModel([NUDGE])
+    plan = best_first(fm, scene(0.0, 0.25), goal("*:x_min=0.35~0.01"))
+    assert [(s.behavior, s.obj) for s in plan.steps] == [("nudge", 1)]
+
+
+def test_relative_goal_brings_two_objects_level():
+    fm = ForwardModel([NUDGE])
+    plan = best_first(fm, scene(0.0, 0.2), goal("0-1:x_min=0~0.01"))
+    assert [(s.behavior, s.obj) for s in plan.steps] == [("nudge", 0), ("nudge", 0)]
+
+
+def test_vanished_objects_cannot_be_acted_on():
+    fm = ForwardModel([NUDGE])
+    state = scene(0.0)
+    state[0, 0] = 0.0
+    assert not best_first(fm, state, goal("0:x_min=0.1~0.01")).found
+
+
+def test_success_probability_counts_every_outcome_that_reaches_the_goal():
+    fm = ForwardModel([THROW])
+    plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
+    assert plan.success_probability == pytest.approx(0.5)
+    twice = plan.steps * 2  # a second throw after a first miss
+    assert success_probability(fm, scene(0.0), goal("*:visibility=0"), twice) == pytest.approx(0.75)
+
+
+def test_inverse_query_ranks_one_step_options():
+    fm = ForwardModel([THROW, SWEEP, NUDGE], min_probability=0.0)
+    ranking = inverse_query(fm, scene(0.0), goal("*:visibility=0"))
+    assert [(r["behavior"], r["probability"]) for r in ranking] == [("sweep", 0.9), ("throw", 0.5), ("nudge", 0.0)]
+
+
+def test_goal_errors_are_one_sentence():
+    with pytest.raises(GoalError, match="unknown feature 'colour'"):
+        goal("0:colour=1")
+    with pytest.raises(GoalError, match="cannot read goal"):
+        goal("zero:x_min=1")
+    with pytest.raises(GoalError, match="relates object 1 to itself"):
+        goal("1-1:x_min=0")
+    with pytest.raises(GoalError, match="robot sees 1 object"):
+        goal("3:visibility=0").check_objects(1)
+    g = goal("0:x_min=0.4", "*:visibility=0~0.2")
+    assert g.to_json() == ["0:x_min=0.4~0.05", "*:visibility=0~0.2"]
+
+
+class ScriptedWorld:
+    """A world whose behaviours do what a script says, whatever the model predicts."""
+
+    def __init__(self, state, script):
+        self.state = state.copy()
+        self.script = script  # behaviour name -> list of effects used in turn
+        self.calls = []
+
+    def perceive(self):
+        return self.state.copy()
+
+    def act(self, behavior, target, alpha=None):
+        self.calls.append((behavior, target))
+        effects = self.script[behavior]
+        e = effects.pop(0) if len(effects) > 1 else effects[0]
+        f = self.state[target] + e
+        if f[0] < 0.5:
+            self.state[target, 0] = 0.0
+        else:
+            self.state[target] = f
+        return self.perceive()
+
+
+def test_monitoring_replans_when_a_step_surprises():
+    fm = ForwardModel([PUSH])
+    world = ScriptedWorld(scene(0.0), {"push": [effect(), effect(0.2), effect(0.2)]})  # the first push misses
+    run = execute(world, fm, goal("0:x_min=0.4~0.01"), max_replans=3)
+    assert run.reached and run.replans == 1
+    assert [s["as_predicted"] for s in run.executed] == [False, True, True]
+
+
+def test_monitoring_stops_repeating_what_fails_and_tries_something_else():
+    fm = ForwardModel([SWEEP, THROW])
+    world = ScriptedWorld(scene(0.0), {"sweep": [effect()], "throw": [effect(vanish=True)]})
+    run = execute(world, fm, goal("*:visibility=0"), max_replans=3)
+    assert run.reached
+    assert world.calls == [("sweep", 0), ("throw", 0)]
+
+
+def test_monitoring_gives_up_after_the_replan_budget():
+    fm = ForwardModel([PUSH])
+    world = ScriptedWorld(scene(0.0), {"push": [effect(0.05)]})  # always a little, never as predicted
+    run = execute(world, fm, goal("0:x_min=0.4~0.01"), max_replans=2)
+    assert not run.reached and run.replans <= 2 and run.reason
+
+
+def test_emulation_derives_goals_by_channel_priority():
+    start = scene(0.0, 0.3)
+    empty = goal_from_observation(np.empty((0, D)), start, SCHEMA)
+    assert empty.to_json() == ["0:visibility=0~0.5", "1:visibility=0~0.5"]
+    lifted = obj(0.5)
+    lifted[SCHEMA.index("z_min")] = 1.0
+    one = goal_from_observation(lifted[None, :], start, SCHEMA)
+    assert {c.name for c in one.constraints} == {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}
+    assert all(c.obj == "*" for c in one.constraints)
+    two = goal_from_observation(scene(0.0, 0.1), start, SCHEMA)
+    assert all(c.obj == (0, 1) for c in two.constraints)
+    assert two.holds(scene(0.5, 0.6)) and not two.holds(start)
