@@ -84,8 +84,11 @@ def track(known: np.ndarray, seen: np.ndarray, gate: float = 0.35) -> np.ndarray
     if known.shape[0] == 0 or seen.shape[0] == 0:
         return out
     cost = np.linalg.norm(_centre(known)[:, None, :] - _centre(seen)[None, :, :], axis=2)
+    # An object already gone is matched only when no visible one can take the detection:
+    # otherwise a dropped object landing near where another fell off would be mistaken for it.
+    cost = cost + np.where(known[:, 0] < 0.5, gate, 0.0)[:, None]
     rows, cols = linear_sum_assignment(cost)
     for r, c in zip(rows, cols):
-        if cost[r, c] <= gate:
+        if cost[r, c] - (gate if known[r, 0] < 0.5 else 0.0) <= gate:
             out[r] = seen[c]
     return out
