@@ -34,6 +34,7 @@ test: imports
 bench: $(STAMP)
 	$(PY) benchmarks/explore.py
 	$(PY) benchmarks/learn.py
+	$(PY) benchmarks/plan.py
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache benchmarks/results

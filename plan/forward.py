@@ -84,6 +84,26 @@ class ForwardModel:
             self.predictions += 1
         return hit
 
+    def prefetch(self, vectors: list[np.ndarray]) -> None:
+        """Predict for many object vectors at once (one call per behaviour and alpha).
+
+        A search needs each new object vector's predictions when it expands that state;
+        asking the predictors for all of a node's children in one batch costs little more
+        than asking for one (scikit-learn's per-call overhead dominates single rows).
+        """
+        fresh = {v.tobytes(): v for v in vectors if v[0] >= 0.5}
+        for b, model in enumerate(self.behaviors):
+            for alpha in self.alphas(b):
+                todo = [v for key, v in fresh.items() if (b, key, alpha) not in self._cache]
+                if not todo:
+                    continue
+                X = np.stack([np.concatenate([v[model.selected], np.asarray(alpha, dtype=float)]) for v in todo])
+                proba = model.predictor.predict_proba(X)
+                classes = np.asarray(model.predictor.classes_, dtype=int)
+                for v, p in zip(todo, proba):
+                    self._cache[(b, v.tobytes(), alpha)] = (classes, p)
+                self.predictions += len(todo)
+
     def apply(self, state: np.ndarray, obj: int, b: int, category: int) -> np.ndarray:
         """The state after behaviour ``b`` on ``obj`` produced ``category``."""
         nxt = state.copy()

@@ -62,7 +62,8 @@ class Plan:
 
 
 def _key(state: np.ndarray) -> bytes:
-    return np.round(state, 3).tobytes()
+    """States within a centimetre (and a hundredth of a histogram bin) of each other are one."""
+    return np.round(state, 2).tobytes()
 
 
 #: Two situations of an object closer than this (metres, every position feature) are the same.
@@ -88,9 +89,21 @@ def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int) -> float
     return cost
 
 
-def _actions(model: ForwardModel, state: np.ndarray):
+#: An outcome that moves no feature of the object more than this is no change at all.
+NO_OP = 0.005
+
+
+def _no_op(before: np.ndarray, after: np.ndarray, obj: int) -> bool:
+    """Neither visibility nor position moved (shape histograms jitter with the view)."""
+    return bool(np.abs(after[obj, :7] - before[obj, :7]).max() < NO_OP)
+
+
+def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None):
+    """(behaviour, object, alpha) to try. A behaviour changes only its own object (chapter
+    8), so when the goal names its objects (no ``*``) acting on any other cannot help."""
+    named = goal.objects() if goal is not None and all(c.obj != "*" for c in goal.constraints) else None
     for obj in range(state.shape[0]):
-        if state[obj, 0] < 0.5:
+        if state[obj, 0] < 0.5 or (named is not None and obj not in named):
             continue
         for b in range(len(model.behaviors)):
             for alpha in model.alphas(b):
@@ -128,10 +141,13 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
             return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                         f"node budget of {max_nodes} expansions spent", tree)
         expanded += 1
-        for b, obj, alpha in _actions(model, state):
+        children = []
+        for b, obj, alpha in _actions(model, state, goal):
             penalty = _distrust(avoid, state, model.names[b], obj) if avoid else 0.0
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
+                if _no_op(state, out.state, obj):
+                    continue  # an outcome that changes nothing cannot be part of a shortest way
                 c = cost - math.log(max(out.probability, 1e-12)) + penalty
                 k = _key(out.state)
                 if best_cost.get(k, math.inf) <= c + 1e-12:
@@ -143,6 +159,9 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                     tree.append({"depth": 1, **step.to_json(), "distance": round(h, 3)})
                 counter += 1
                 heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,)))
+                if len(steps) + 1 < max_depth:
+                    children.append(out.state[obj])
+        model.prefetch(children)
     return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                 f"no plan of at most {max_depth} steps reaches the goal", tree)
 
@@ -163,7 +182,7 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                 return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
-            for b, obj, alpha in _actions(model, state):
+            for b, obj, alpha in _actions(model, state, goal):
                 if avoid and _distrust(avoid, state, model.names[b], obj) >= 2 * DISTRUST:
                     continue  # chaining has no costs: a step that failed here is simply not retried
                 outs = model.outcomes(state, obj, b, alpha)
@@ -171,6 +190,8 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                     continue
                 out = outs[0]
                 generated += 1
+                if _no_op(state, out.state, obj):
+                    continue
                 k = _key(out.state)
                 if k in seen:
                     continue

@@ -22,7 +22,7 @@ def demo(
     workers: Workers = 2,
 ) -> None:
     """Explore the table scene, learn its affordances, and measure them on new interactions."""
-    from afford_cli.commands import cluster, evaluate, explore, inspect, predict, select_features, train
+    from afford_cli.commands import cluster, emulate, evaluate, explore, inspect, plan, predict, select_features, train
 
     out_dir.mkdir(parents=True, exist_ok=True)
     console = Output().report
@@ -41,6 +41,14 @@ def demo(
     evaluate.evaluate(path["model"], path["heldout"], baselines=True, seed=seed)
     console.rule("[bold]6. predict: a new scene, checked in simulation")
     predict.predict(path["model"], seed=seed + 2, objects=2, run_check=True)
-    console.rule("[bold]7. inspect: the model file, verified")
+    console.rule("[bold]7. plan: clear the table, executed in simulation with monitoring")
+    plan.plan(path["model"], goal=["*:visibility=0"], seed=seed + 3, objects=2, reachable=True, execute=True)
+    console.rule("[bold]8. emulate: shown two objects side by side, bring two others together")
+    layouts = Path(__file__).resolve().parents[2] / "examples" / "layouts"
+    if (layouts / "close-shown.toml").exists():
+        emulate.emulate(path["model"], observe=str(layouts / "close-shown.toml"), start=str(layouts / "close-start-1.toml"))
+    else:  # an installed package without the examples directory
+        Output().warn(f"example layouts not found in {layouts}; skipping emulation")
+    console.rule("[bold]9. inspect: the model file, verified")
     inspect.inspect(path["model"])
     Output().info(f"artefacts in {out_dir}/")

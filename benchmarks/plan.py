@@ -1,0 +1,99 @@
+"""Planning speed: three objects, four behaviours, plans up to depth 5.
+
+    python benchmarks/plan.py [--model PATH] [--interactions 2000] [--scenes 20]
+
+Without ``--model`` it explores and trains a model first (the time for that is reported
+apart). Each scene draws three objects within reach and asks for all three to be gone
+(plans of three or more steps) and for object 0 to end 20 cm further from the robot.
+Prints one JSON object and writes it to ``--out``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+
+def build_model(interactions: int, seed: int) -> str:
+    from afford_cli.app import app
+    from typer.testing import CliRunner
+
+    d = Path(tempfile.mkdtemp(prefix="afford-bench-"))
+    runner = CliRunner()
+    for args in (["explore", "--interactions", str(interactions), "--seed", str(seed), "--workers", "2", "-o", str(d / "i.afford")],
+                 ["cluster", str(d / "i.afford"), "-o", str(d / "e.afford")],
+                 ["select-features", str(d / "e.afford"), "-o", str(d / "f.afford")],
+                 ["train", str(d / "f.afford"), "-o", str(d / "m.afford")]):
+        result = runner.invoke(app, args)
+        if result.exit_code != 0:
+            raise SystemExit(result.output)
+    return str(d / "m.afford")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--model")
+    ap.add_argument("--interactions", type=int, default=2000)
+    ap.add_argument("--scenes", type=int, default=20)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "plan.json"))
+    args = ap.parse_args()
+    t = time.perf_counter()
+    model_path = args.model or build_model(args.interactions, args.seed)
+    build_s = None if args.model else round(time.perf_counter() - t, 1)
+
+    from afford_cli.learning import forward_model, load_model
+    from afford_cli.scenes_io import open_world, scene_objects
+    from plan.goals import parse_goal
+    from plan.search import best_first
+
+    model = load_model(model_path)
+    goals = {
+        "all three gone": ["0:visibility=0", "1:visibility=0", "2:visibility=0"],
+        "object 0 pushed 20 cm away": None,  # filled per scene
+    }
+    rows = []
+    for s in range(args.scenes):
+        scene, specs = scene_objects("table", args.seed + s, 3, None, reachable=True)
+        state = open_world(scene, specs, args.seed + s).perceive()
+        if state.shape[0] < 3:
+            continue
+        x = state[0, model.schema.index("x_min")]
+        for name, exprs in goals.items():
+            exprs = exprs or [f"0:x_min={x + 0.2:.3f}~0.06"]
+            fm = forward_model(model)  # a fresh cache: every plan pays for its own predictions
+            plan = best_first(fm, state, parse_goal(exprs, model.schema), max_depth=5, max_nodes=20000)
+            rows.append({"goal": name, "found": plan.found, "length": len(plan.steps), "seconds": plan.seconds,
+                         "expanded": plan.expanded, "generated": plan.generated, "predictions": fm.predictions})
+    secs = np.array([r["seconds"] for r in rows])
+    nodes = np.array([r["expanded"] for r in rows])
+    result = {
+        "benchmark": "plan",
+        "model_build_seconds": build_s,
+        "plans": len(rows),
+        "found": int(sum(r["found"] for r in rows)),
+        "seconds_per_plan": {"mean": round(float(secs.mean()), 4), "median": round(float(np.median(secs)), 4),
+                             "max": round(float(secs.max()), 4)},
+        "expanded_per_plan": {"mean": round(float(nodes.mean()), 1), "max": int(nodes.max())},
+        "nodes_per_second": round(float(nodes.sum() / secs.sum()), 1),
+        "by_goal": {g: {"found": sum(r["found"] for r in rows if r["goal"] == g),
+                        "mean_length": round(float(np.mean([r["length"] for r in rows if r["goal"] == g and r["found"]] or [0])), 2),
+                        "mean_seconds": round(float(np.mean([r["seconds"] for r in rows if r["goal"] == g])), 4)}
+                    for g in goals},
+    }
+    text = json.dumps(result, indent=1)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(text + "\n")
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
