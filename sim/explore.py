@@ -195,8 +195,10 @@ def explore(
             else:
                 if total_rows >= interactions:
                     break
-                # Rows per episode average about two: ask for what is likely missing.
-                need = max(workers * chunk, int((interactions - total_rows) / 1.8) + 1)
+                # Ask for about as many episodes as the rows still missing need, at the rate
+                # seen so far (about two rows an episode), so little is explored in vain.
+                rate = total_rows / next_episode if next_episode else 2.0
+                need = max(workers * chunk, int((interactions - total_rows) / max(rate, 1.0)) + 1)
                 stop = next_episode + need
             jobs = (delayed(_run_chunk)(scene, seed, eps, max_steps) for eps in _chunks(next_episode, stop, chunk))
             for result in parallel(jobs):
