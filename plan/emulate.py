@@ -16,7 +16,6 @@ from plan.goals import DEFAULT_TOLERANCE, Constraint, Goal
 
 __all__ = ["goal_from_observation"]
 
-_POSITION = ("x_min", "x_max", "y_min", "y_max", "z_min", "z_max")
 
 
 def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: FeatureSchema,
@@ -37,9 +36,15 @@ def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: Featu
         return Goal(tuple(Constraint(i, vis, "visibility", 0.0, DEFAULT_TOLERANCE["visibility"], "visibility")
                           for i in range(k)))
     if seen.shape[0] == 1:  # one object shown: an object should be where it is
+        # Its footprint on the table plane, loosely (pushes move objects in steps of a
+        # decimetre or more, and the start object need not have the shown one's size), and
+        # the height of its bottom (lifted or not); its top depends on the object's size.
         f = seen[0]
-        return Goal(tuple(Constraint("*", schema.index(n), n, float(f[schema.index(n)]), tolerance, "position")
-                          for n in _POSITION))
+        out = [Constraint("*", schema.index(n), n, float(f[schema.index(n)]), 2 * tolerance, "position")
+               for n in ("x_min", "x_max", "y_min", "y_max")]
+        z = schema.index("z_min")
+        out.append(Constraint("*", z, "z_min", float(f[z]), tolerance, "position"))
+        return Goal(tuple(out))
     if k < 2:
         raise ValueError("the shown scene relates two objects, but the start scene has fewer than two")
     # Two (or more) shown: keep the relation of the first two, on the table plane.

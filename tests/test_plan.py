@@ -189,7 +189,7 @@ def test_emulation_derives_goals_by_channel_priority():
     lifted = obj(0.5)
     lifted[SCHEMA.index("z_min")] = 1.0
     one = goal_from_observation(lifted[None, :], start, SCHEMA)
-    assert {c.name for c in one.constraints} == {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"}
+    assert {c.name for c in one.constraints} == {"x_min", "x_max", "y_min", "y_max", "z_min"}
     assert all(c.obj == "*" for c in one.constraints)
     two = goal_from_observation(scene(0.0, 0.1), start, SCHEMA)
     assert all(c.obj == (0, 1) for c in two.constraints)
