@@ -112,7 +112,11 @@ def plan(
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
                 sc, specs = scene_objects(scene, base + e, objects, None, reachable)
-                entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans))
+                try:
+                    entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans))
+                except (AffordError, ValueError) as exc:  # e.g. an object hidden behind another
+                    entries.append({"seed": base + e, "skipped": str(exc),
+                                    "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})
                 update(e + 1)
     result = summarise(entries, execute)
     result["goal"] = g.to_json()
@@ -143,10 +147,11 @@ def summarise(entries: list[dict], executed: bool) -> dict:
             slot["reached"] += int(e.get("reached", False))
             first_ok.append(bool(e.get("first_plan_worked", False)))
     found = sum(1 for e in entries if e["plan"]["found"])
-    out = {"episodes": len(entries), "found": found, "by_length": dict(sorted(by_length.items(), key=lambda kv: int(kv[0]))),
+    planned = [e for e in entries if "skipped" not in e]
+    out = {"episodes": len(entries), "skipped": len(entries) - len(planned), "found": found, "by_length": dict(sorted(by_length.items(), key=lambda kv: int(kv[0]))),
            "mean_success_probability": round(float(np.mean(probs)), 4) if probs else None,
-           "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in entries])), 4),
-           "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in entries])), 1)}
+           "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in planned] or [0.0])), 4),
+           "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in planned] or [0.0])), 1)}
     if executed:
         out["reached"] = sum(int(e.get("reached", False)) for e in entries)
         out["first_plan_worked"] = int(sum(first_ok))
@@ -155,7 +160,8 @@ def summarise(entries: list[dict], executed: bool) -> dict:
 
 
 def render_summary(console, result: dict) -> None:
-    table = Table(title=f"{result['episodes']} scenes: plans found {result['found']}"
+    skipped = f" ({result['skipped']} skipped: the robot did not see every object the goal names)" if result["skipped"] else ""
+    table = Table(title=f"{result['episodes']} scenes{skipped}: plans found {result['found']}"
                         + (f", goal reached {result['reached']}" if "reached" in result else ""), box=box.SIMPLE_HEAD)
     for col in ("plan length", "found", "reached", "rate"):
         table.add_column(col, justify="right")
