@@ -108,7 +108,7 @@ _MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created"
 
 
 def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict, selected: dict,
-                  predictors: dict, settings: dict) -> tuple[dict, dict, dict]:
+                  predictors: dict, settings: dict, known: dict | None = None) -> tuple[dict, dict, dict]:
     from learn.affordances import behaviour_rows, n_params, predictor_inputs
 
     arrays, blobs, cv, categories = {}, {}, {}, {}
@@ -121,6 +121,8 @@ def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects
         arrays[f"train_y.{name}"] = labels[rows].astype(np.int16)
         blobs[_blob_name("effects", name)] = dump_estimator(ec)
         blobs[_blob_name("predictor", name)] = dump_estimator(model)
+        if known and known.get(name) is not None:
+            blobs[_blob_name("known", name)] = dump_estimator(known[name])
         cv[name] = model.cv_report_
         categories[name] = category_report(data, labels, b, ec.prototypes_)
     meta = {
@@ -149,6 +151,8 @@ class LoadedModel:
         self.prototypes = {n: art.arrays[f"prototypes.{n}"] for n in self.names}
         self.effects = {n: art.estimator(_blob_name("effects", n), TRUSTED) for n in self.names}
         self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED) for n in self.names}
+        self.known = {n: art.estimator(_blob_name("known", n), TRUSTED) if _blob_name("known", n) in art.blobs else None
+                      for n in self.names}
 
     def n_params(self, name: str) -> int:
         return len(self.behaviors[self.names.index(name)].get("parameters", []))
@@ -170,5 +174,6 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02):
     behaviors = []
     for b, name in enumerate(model.names):
         params = [(float(p["low"]), float(p["high"])) for p in model.behaviors[b].get("parameters", [])]
-        behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params))
+        behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params,
+                                       known=model.known[name]))
     return ForwardModel(behaviors, min_probability=min_probability)

@@ -25,7 +25,7 @@ from learn.relevance import FeatureRelevance, feature_groups
 
 __all__ = [
     "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",
-    "behaviour_seed",
+    "behaviour_seed", "train_known",
 ]
 
 #: Fewest interactions of one behaviour worth learning from.
@@ -101,6 +101,29 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
         out[name] = fr.fit(data.before[rows], y)
         if progress is not None:
             progress(b + 1)
+    return out
+
+
+def train_known(data: Interactions, labels: np.ndarray, selected: dict[str, np.ndarray], *,
+                seed: int = 0, min_rows: int = 10) -> dict:
+    """Per behaviour, P(the effect is of a kind the categories kept | object, alpha).
+
+    Frequency pruning drops rare effects with their members, so a predictor trained on the
+    kept categories has never seen them: for an object whose interactions mostly ended in
+    a dropped kind (a held object pushed: it drops, then is dragged), it still answers with
+    a kept category, confidently. The planner multiplies its step probabilities by this
+    one, so plans through such steps are no longer mistaken for sure ones. Behaviours with
+    fewer than ``min_rows`` dropped rows get none (``None``).
+    """
+    out: dict = {}
+    for b, name in enumerate(data.behavior_names):
+        rows = behaviour_rows(data, b)
+        known = (labels[rows] >= 0).astype(int)
+        if min(known.sum(), (1 - known).sum()) < min_rows:
+            out[name] = None
+            continue
+        X = predictor_inputs(data.before[rows], data.params[rows], selected[name], n_params(data, b))
+        out[name] = AffordancePredictor(kernel="rbf", calibration="sigmoid", random_state=behaviour_seed(seed, b)).fit(X, known)
     return out
 
 

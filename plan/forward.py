@@ -2,7 +2,9 @@
 
 For an object f, a behaviour b and its parameters alpha, the predictor gives P(E | f, b,
 alpha) over b's effect categories; the next state of that object is f + prototype(E), and
-no other object changes (chapter 8). An object that the prototype makes vanish keeps its
+no other object changes (chapter 8). Where the model also learned P(known | f, b, alpha),
+the chance that the effect is of a kind its categories kept at all, the category
+probabilities are multiplied by it: the rest is an unknown outcome, which no plan counts on. An object that the prototype makes vanish keeps its
 last seen position and shape with visibility 0, as perception does.
 
 Predictions depend only on the object's own features, so they are cached by the object's
@@ -28,6 +30,7 @@ class BehaviorModel:
     selected: np.ndarray               # object-feature columns the predictor reads
     prototypes: np.ndarray             # (n_categories, d) mean effects
     parameters: list[tuple[float, float]] = field(default_factory=list)  # alpha ranges
+    known: object | None = None        # P(the effect is of a kept kind): predict_proba, classes_ [0, 1]
 
 
 @dataclass(frozen=True)
@@ -74,31 +77,31 @@ class ForwardModel:
     def distribution(self, f: np.ndarray, b: int, alpha: tuple = ()) -> tuple[np.ndarray, np.ndarray]:
         """(categories, probabilities) of behaviour ``b`` on object vector ``f``."""
         key = (b, f.tobytes(), alpha)
-        hit = self._cache.get(key)
-        if hit is None:
-            model = self.behaviors[b]
-            x = np.concatenate([f[model.selected], np.asarray(alpha, dtype=float)])[None, :]
-            proba = model.predictor.predict_proba(x)[0]
-            hit = (np.asarray(model.predictor.classes_, dtype=int), proba)
-            self._cache[key] = hit
-            self.predictions += 1
-        return hit
+        if key not in self._cache:
+            self.prefetch([f], b, alpha)
+        return self._cache[key]
 
-    def prefetch(self, vectors: list[np.ndarray]) -> None:
+    def prefetch(self, vectors: list[np.ndarray], only: int | None = None, alpha_only: tuple | None = None) -> None:
         """Predict for many object vectors at once (one call per behaviour and alpha).
 
         A search needs each new object vector's predictions when it expands that state;
         asking the predictors for all of a node's children in one batch costs little more
         than asking for one (scikit-learn's per-call overhead dominates single rows).
         """
-        fresh = {v.tobytes(): v for v in vectors if v[0] >= 0.5}
+        fresh = {v.tobytes(): v for v in vectors}
         for b, model in enumerate(self.behaviors):
-            for alpha in self.alphas(b):
+            if only is not None and b != only:
+                continue
+            for alpha in self.alphas(b) if alpha_only is None else [alpha_only]:
                 todo = [v for key, v in fresh.items() if (b, key, alpha) not in self._cache]
                 if not todo:
                     continue
                 X = np.stack([np.concatenate([v[model.selected], np.asarray(alpha, dtype=float)]) for v in todo])
                 proba = model.predictor.predict_proba(X)
+                if model.known is not None:
+                    # the chance that the effect is one of the kinds the categories kept
+                    kept = model.known.predict_proba(X)[:, list(model.known.classes_).index(1)]
+                    proba = proba * kept[:, None]
                 classes = np.asarray(model.predictor.classes_, dtype=int)
                 for v, p in zip(todo, proba):
                     self._cache[(b, v.tobytes(), alpha)] = (classes, p)

@@ -194,3 +194,21 @@ def test_emulation_derives_goals_by_channel_priority():
     two = goal_from_observation(scene(0.0, 0.1), start, SCHEMA)
     assert all(c.obj == (0, 1) for c in two.constraints)
     assert two.holds(scene(0.5, 0.6)) and not two.holds(start)
+
+
+class Known:
+    """P(the effect is of a kept kind) = 0.25 everywhere."""
+
+    classes_ = np.array([0, 1])
+
+    def predict_proba(self, X):
+        return np.tile([0.75, 0.25], (len(X), 1))
+
+
+def test_unknown_effects_lower_the_probabilities_plans_count_on():
+    risky = BehaviorModel("risky", Fixed([1.0]), np.array([0]), np.stack([effect(vanish=True)]), known=Known())
+    fm = ForwardModel([risky, SWEEP])
+    (out,) = fm.outcomes(scene(0.0), 0, 0)
+    assert out.probability == pytest.approx(0.25)  # the rest is an outcome no plan counts on
+    plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
+    assert [s.behavior for s in plan.steps] == ["sweep"]

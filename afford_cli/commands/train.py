@@ -28,7 +28,7 @@ def train(
     json: Json = False,
 ) -> None:
     """Train each behaviour's effect-category predictor (thesis 8.4.2), probabilities calibrated."""
-    from learn.affordances import train_predictors
+    from learn.affordances import train_known, train_predictors
 
     out = Output(json, stdout_busy=output == "-")
     art, data = read_rows(path, ("effects", "features"))
@@ -37,8 +37,9 @@ def train(
     start = time.perf_counter()
     with out.progress(f"training predictors ({kernel.value} SVM)", len(data.behaviors)) as update:
         predictors = train_predictors(data, labels, selected, kernel=kernel.value, seed=seed, progress=update)
+    known = train_known(data, labels, selected, seed=seed)
     settings = {"kernel": kernel.value, "selection": art.kind}
-    arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings)
+    arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known)
     write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     result = {"output": output, "seconds": round(time.perf_counter() - start, 3),
               "behaviors": {n: {"cv_accuracy": cv["cv_accuracy"], "best_params": cv["best_params"],
