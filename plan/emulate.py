@@ -43,7 +43,7 @@ def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: Featu
         out = [Constraint("*", schema.index(n), n, float(f[schema.index(n)]), 2 * tolerance, "position")
                for n in ("x_min", "x_max", "y_min", "y_max")]
         z = schema.index("z_min")
-        out.append(Constraint("*", z, "z_min", float(f[z]), tolerance, "position"))
+        out.append(Constraint("*", z, "z_min", float(f[z]), 1.5 * tolerance, "position"))
         return Goal(tuple(out))
     if k < 2:
         raise ValueError("the shown scene relates two objects, but the start scene has fewer than two")
