@@ -11,7 +11,6 @@ histograms, tracking).
 from __future__ import annotations
 
 import argparse
-import json
 import platform
 import sys
 import time
@@ -20,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import emit  # noqa: E402
 
 import features.objects as fobj  # noqa: E402
 import sim.camera as cam  # noqa: E402
@@ -90,10 +92,7 @@ def main() -> None:
     for _ in range(50):
         fobj.perceive(image, w.config.roi())
     result["features_alone_ms"] = round(1000 * (time.perf_counter() - t) / 50, 2)
-    text = json.dumps(result, indent=1)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(text + "\n")
-    print(text)
+    emit(result, args.out)
 
 
 if __name__ == "__main__":

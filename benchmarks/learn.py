@@ -9,12 +9,14 @@ runs. Prints one JSON object and writes it to ``--out``.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import emit  # noqa: E402
 
 from afford_cli.artifacts import read_artifact  # noqa: E402
 from afford_cli.datasets import interactions_from_artifact  # noqa: E402
@@ -65,10 +67,7 @@ def main() -> None:
         },
     }
     result["seconds"]["pipeline_cluster_relieff_train"] = round(cluster_s + selections["relieff"] + train_s, 2)
-    text = json.dumps(result, indent=1)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(text + "\n")
-    print(text)
+    emit(result, args.out)
 
 
 if __name__ == "__main__":

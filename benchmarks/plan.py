@@ -11,7 +11,6 @@ Prints one JSON object and writes it to ``--out``.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 import time
@@ -20,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import emit  # noqa: E402
 
 
 def build_model(interactions: int, seed: int) -> str:
@@ -89,10 +91,7 @@ def main() -> None:
                         "mean_seconds": round(float(np.mean([r["seconds"] for r in rows if r["goal"] == g])), 4)}
                     for g in goals},
     }
-    text = json.dumps(result, indent=1)
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(text + "\n")
-    print(text)
+    emit(result, args.out)
 
 
 if __name__ == "__main__":

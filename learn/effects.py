@@ -80,6 +80,11 @@ def _order_by_count(labels: np.ndarray, centers: np.ndarray) -> np.ndarray:
     return new_id
 
 
+def _sq_distances(Z: np.ndarray, centers: np.ndarray) -> np.ndarray:
+    """Squared Euclidean distances (n, k) of rows to centres."""
+    return (Z * Z).sum(1)[:, None] - 2.0 * Z @ centers.T + (centers * centers).sum(1)[None, :]
+
+
 class EffectCategories(BaseEstimator):
     """Discover effect categories and their prototypes from effect vectors.
 
@@ -424,6 +429,18 @@ class EffectCategories(BaseEstimator):
                 return np.zeros(Zc.shape[0], dtype=int), centre, 1, []
 
     # --------------------------------------------------------------- prediction
+    def _scaled(self, E) -> np.ndarray:
+        """Checked effects, in the scaled units the categories were found in."""
+        check_is_fitted(self)
+        E = check_array(E, dtype=np.float64, ensure_all_finite=False, input_name="E")
+        _check_finite(E, "E")
+        if E.shape[1] != self.n_features_in_:
+            raise ValueError(
+                f"E has {E.shape[1]} features, but EffectCategories is expecting "
+                f"{self.n_features_in_} features as input."
+            )
+        return E / self.scale_
+
     def predict(self, E):
         """Assign effects to the nearest kept category.
 
@@ -441,21 +458,10 @@ class EffectCategories(BaseEstimator):
         labels : ndarray of shape (n_samples,)
             Category ids in ``0 .. n_categories_ - 1``.
         """
-        check_is_fitted(self)
-        E = check_array(E, dtype=np.float64, ensure_all_finite=False, input_name="E")
-        _check_finite(E, "E")
-        if E.shape[1] != self.n_features_in_:
-            raise ValueError(
-                f"E has {E.shape[1]} features, but EffectCategories is expecting "
-                f"{self.n_features_in_} features as input."
-            )
-        Z = E / self.scale_
+        Z = self._scaled(E)
         total = np.zeros((E.shape[0], self.n_categories_))
         for j, cols in enumerate(self.columns_):
-            c = self.centers_[j]
-            Zc = Z[:, cols]
-            d = (Zc * Zc).sum(1)[:, None] - 2.0 * Zc @ c.T + (c * c).sum(1)[None, :]
-            total += d[:, self.category_codes_[:, j]]
+            total += _sq_distances(Z[:, cols], self.centers_[j])[:, self.category_codes_[:, j]]
         return np.argmin(total, axis=1)
 
     def assign(self, E):
@@ -477,20 +483,10 @@ class EffectCategories(BaseEstimator):
         labels : ndarray of shape (n_samples,)
             Category ids in ``0 .. n_categories_ - 1``, or -1.
         """
-        check_is_fitted(self)
-        E = check_array(E, dtype=np.float64, ensure_all_finite=False, input_name="E")
-        _check_finite(E, "E")
-        if E.shape[1] != self.n_features_in_:
-            raise ValueError(
-                f"E has {E.shape[1]} features, but EffectCategories is expecting "
-                f"{self.n_features_in_} features as input."
-            )
-        Z = E / self.scale_
+        Z = self._scaled(E)
         codes = np.empty((E.shape[0], len(self.columns_)), dtype=int)
         for j, cols in enumerate(self.columns_):
-            c = self.all_centers_[j]
-            Zc = Z[:, cols]
-            d = (Zc * Zc).sum(1)[:, None] - 2.0 * Zc @ c.T + (c * c).sum(1)[None, :]
+            d = _sq_distances(Z[:, cols], self.all_centers_[j])
             codes[:, j] = np.asarray(self.all_codes_[j])[np.argmin(d, axis=1)]
         lookup = {tuple(int(v) for v in row): i for i, row in enumerate(self.category_codes_)}
         return np.array([lookup.get(tuple(int(v) for v in row), -1) for row in codes], dtype=int)
