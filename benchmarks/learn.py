@@ -14,9 +14,8 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import emit  # noqa: E402
+from benchmarks._common import emit  # noqa: E402
 
 from afford_cli.artifacts import read_artifact  # noqa: E402
 from afford_cli.datasets import interactions_from_artifact  # noqa: E402
