@@ -22,26 +22,31 @@ def bar_row(values: list[float], scale: float) -> Text:
 
 def render_categories(console, behavior: str, categories: list[dict], channels: list[tuple[str, list[str]]]) -> None:
     """A behaviour's categories: size, prototype per channel as bar rows, what physically happened."""
-    table = Table(title=f"{behavior}: {len(categories)} effect categories", box=box.SIMPLE_HEAD)
-    table.add_column("id", justify="right")
-    table.add_column("n", justify="right")
+    table = Table(title=f"{behavior}: {len(categories)} effect categories (prototype effects; the position "
+                        "channel also gives the centre's shift in metres)", box=box.SIMPLE_HEAD)
+    table.add_column("id", justify="right", no_wrap=True, min_width=2)
+    table.add_column("n", justify="right", no_wrap=True, min_width=4)
     scales = {}
     for channel, names in channels:
-        table.add_column(channel, no_wrap=True)
+        table.add_column(channel if len(names) > 1 else channel[:3], no_wrap=True)
         scales[channel] = max((abs(c["prototype"][n]) for c in categories for n in names), default=0.0)
-    table.add_column("what happened (ground truth)", no_wrap=True)
+    table.add_column("what happened (truth)", no_wrap=True)
     for c in categories:
         cells = [str(c["id"]), str(c["count"])]
         for channel, names in channels:
             values = [c["prototype"][n] for n in names]
-            if len(names) <= 6:  # short channels also get their numbers
-                row = bar_row(values, scales[channel])
-                row.append(" " + " ".join(f"{v:+.2f}" for v in values), style="dim")
-                cells.append(row)
-            else:
-                cells.append(bar_row(values, scales[channel]))
+            row = bar_row(values, scales[channel])
+            if len(names) == 1:
+                row.append(f" {values[0]:+.2f}", style="dim")
+            elif all(n.endswith(("_min", "_max")) for n in names):
+                # a position channel: also the shift of the centre along each axis
+                axes = dict.fromkeys(n.rsplit("_", 1)[0] for n in names)
+                shift = [(c["prototype"][f"{a}_min"] + c["prototype"][f"{a}_max"]) / 2 for a in axes]
+                row.append(" " + " ".join(f"{a}{v:+.2f}" for a, v in zip(axes, shift)), style="dim")
+            cells.append(row)
         outcomes = c.get("outcomes", {})
-        cells.append(", ".join(f"{k} {100 * v:.0f}%" for k, v in sorted(outcomes.items(), key=lambda kv: -kv[1])))
+        top = sorted(outcomes.items(), key=lambda kv: -kv[1])[:2]
+        cells.append(", ".join(f"{k} {100 * v:.0f}%" for k, v in top))
         table.add_row(*cells)
     console.print(table)
 
