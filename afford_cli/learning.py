@@ -176,4 +176,7 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02):
         params = [(float(p["low"]), float(p["high"])) for p in model.behaviors[b].get("parameters", [])]
         behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params,
                                        known=model.known[name]))
-    return ForwardModel(behaviors, min_probability=min_probability)
+    names = model.schema.names
+    histograms = [np.array([i for i, n in enumerate(names) if n.startswith(prefix + "_")])
+                  for prefix in ("elevation", "azimuth")]
+    return ForwardModel(behaviors, min_probability=min_probability, histograms=[h for h in histograms if h.size])

@@ -50,10 +50,16 @@ class ForwardModel:
         Outcomes less likely than this are not expanded by the search.
     param_steps : int
         Grid points per parameter of a parametric behaviour (chapter 9).
+    histograms : list of index arrays, optional
+        Feature columns that form a normalised histogram (the shape channel's two): after
+        adding a prototype they are clipped at 0 and renormalised, so that a predicted
+        object stays an object the predictors could have seen.
     """
 
-    def __init__(self, behaviors: list[BehaviorModel], min_probability: float = 0.02, param_steps: int = 5):
+    def __init__(self, behaviors: list[BehaviorModel], min_probability: float = 0.02, param_steps: int = 5,
+                 histograms: list[np.ndarray] | None = None):
         self.behaviors = behaviors
+        self.histograms = [np.asarray(h) for h in (histograms or [])]
         self.names = [b.name for b in behaviors]
         self.min_probability = min_probability
         self.param_steps = param_steps
@@ -115,6 +121,10 @@ class ForwardModel:
             nxt[obj, 0] = 0.0
         else:
             f[0] = 1.0
+            for h in self.histograms:  # a predicted histogram is still a histogram
+                bins = np.clip(f[h], 0.0, None)
+                total = bins.sum()
+                f[h] = bins / total if total > 0 else state[obj, h]
             nxt[obj] = f
         return nxt
 
