@@ -35,6 +35,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/explore.py
 	$(PY) benchmarks/learn.py
 	$(PY) benchmarks/plan.py
+	$(PY) benchmarks/emulate.py
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache benchmarks/results
