@@ -87,6 +87,11 @@ class ForwardModel:
             self.prefetch([f], b, alpha)
         return self._cache[key]
 
+    def cached(self, f: np.ndarray) -> bool:
+        """Are every behaviour's predictions for object vector ``f`` at hand?"""
+        key = f.tobytes()
+        return all((b, key, a) in self._cache for b in range(len(self.behaviors)) for a in self.alphas(b))
+
     def prefetch(self, vectors: list[np.ndarray], only: int | None = None, alpha_only: tuple | None = None) -> None:
         """Predict for many object vectors at once (one call per behaviour and alpha).
 

@@ -127,6 +127,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
     best_cost: dict[bytes, float] = {_key(start): 0.0}
     expanded = generated = 0
     tree: list[dict] = []
+    pending: list[np.ndarray] = []
     while frontier:
         _, _, _, cost, state, steps = heapq.heappop(frontier)
         if goal.holds(state):
@@ -141,7 +142,12 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
             return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                         f"node budget of {max_nodes} expansions spent", tree)
         expanded += 1
-        children = []
+        # Predictions wait until a node needs them, then come for every vector met so far
+        # in one batch per behaviour: scikit-learn's per-call overhead, not the rows, is
+        # what a planning search pays for.
+        if any(not model.cached(state[i]) for i in range(state.shape[0]) if state[i, 0] >= 0.5):
+            model.prefetch(pending + [state[i] for i in range(state.shape[0])])
+            pending = []
         for b, obj, alpha in _actions(model, state, goal):
             penalty = _distrust(avoid, state, model.names[b], obj) if avoid else 0.0
             for out in model.outcomes(state, obj, b, alpha):
@@ -160,8 +166,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                 counter += 1
                 heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,)))
                 if len(steps) + 1 < max_depth:
-                    children.append(out.state[obj])
-        model.prefetch(children)
+                    pending.append(out.state[obj])
     return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                 f"no plan of at most {max_depth} steps reaches the goal", tree)
 
