@@ -11,6 +11,8 @@ from typing import Annotated
 
 import typer
 
+from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.datasets import interactions_members
 from afford_cli.options import Seed, Workers
 from afford_cli.output import Output
 
@@ -29,7 +31,15 @@ def demo(
     path = {k: str(out_dir / f"{k}.afford") for k in ("interactions", "heldout", "effects", "features", "model")}
 
     console.rule(f"[bold]1. explore: the robot pushes and lifts random objects ({interactions} interactions)")
-    explore.explore(output=path["interactions"], interactions=interactions, seed=seed, workers=workers)
+    scene = explore.make_scene("table")
+    data, seconds = explore.run_explore(Output(), scene, episodes=None, interactions=interactions, seed=seed,
+                                        workers=workers, max_steps=10)
+    arrays, meta = interactions_members(data)
+    write_artifact(path["interactions"], artifact_bytes("interactions", arrays, meta, seed=seed))
+    s = explore.summary(data, seconds)
+    console.print(f"recorded {s['interactions']} interactions in {s['episodes']} episodes "
+                  f"({s['interactions_per_second']}/s) -> {path['interactions']}; what the file holds, verified:")
+    inspect.inspect(path["interactions"])
     console.rule("[bold]2. cluster: effect categories per behaviour, discovered without labels")
     cluster.cluster(path["interactions"], path["effects"], seed=seed)
     console.rule("[bold]3. select-features: what the robot must look at (ReliefF)")

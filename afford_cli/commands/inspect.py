@@ -5,7 +5,7 @@ from __future__ import annotations
 from rich.table import Table
 
 from afford_cli.artifacts import Artifact, read_artifact
-from afford_cli.datasets import interactions_from_artifact, outcome_table
+from afford_cli.datasets import behaviour_counts, interactions_from_artifact, outcome_table
 from afford_cli.options import InputPath, Json
 from afford_cli.output import Output
 from afford_cli.plots import PlotDir, artefact_plots, plot_directory, written
@@ -38,7 +38,7 @@ def describe(art: Artifact) -> dict:
         info.update({
             "n_interactions": m["n_interactions"],
             "n_episodes": m.get("n_episodes"),
-            "counts": m.get("counts", {}),
+            "counts": behaviour_counts(data),
             "outcomes": outcome_table(data),
             "scene": m.get("scene", {}),
         })
