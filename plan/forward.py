@@ -64,6 +64,7 @@ class ForwardModel:
         self.min_probability = min_probability
         self.param_steps = param_steps
         self._cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self._fast: dict[int, object] = {}
         self.predictions = 0
 
     def index(self, name: str) -> int:
@@ -87,6 +88,16 @@ class ForwardModel:
             self.prefetch([f], b, alpha)
         return self._cache[key]
 
+    def _proba(self, predictor):
+        """The predictor's fast probability function where it has one (same numbers)."""
+        key = id(predictor)
+        if key not in self._fast:
+            from learn.predictors import AffordancePredictor, fast_predict_proba
+
+            self._fast[key] = (fast_predict_proba(predictor) if isinstance(predictor, AffordancePredictor)
+                               else predictor.predict_proba)
+        return self._fast[key]
+
     def cached(self, f: np.ndarray) -> bool:
         """Are every behaviour's predictions for object vector ``f`` at hand?"""
         key = f.tobytes()
@@ -108,10 +119,10 @@ class ForwardModel:
                 if not todo:
                     continue
                 X = np.stack([np.concatenate([v[model.selected], np.asarray(alpha, dtype=float)]) for v in todo])
-                proba = model.predictor.predict_proba(X)
+                proba = self._proba(model.predictor)(X)
                 if model.known is not None:
                     # the chance that the effect is one of the kinds the categories kept
-                    kept = model.known.predict_proba(X)[:, list(model.known.classes_).index(1)]
+                    kept = self._proba(model.known)(X)[:, list(model.known.classes_).index(1)]
                     proba = proba * kept[:, None]
                 classes = np.asarray(model.predictor.classes_, dtype=int)
                 for v, p in zip(todo, proba):

@@ -405,3 +405,19 @@ def test_baseline_scores():
     s = baseline_scores(Xtr, ytr, Xte, yte, random_state=0)
     assert s["majority"] == pytest.approx(1 / 3)
     assert s["knn"] == pytest.approx(2 / 3) and s["random_forest"] == pytest.approx(2 / 3)
+
+
+@pytest.mark.parametrize("kernel", ["rbf", "linear"])
+def test_fast_probabilities_equal_predict_proba(kernel):
+    from learn.predictors import fast_predict_proba
+
+    rng = np.random.default_rng(5)
+    X = rng.normal(size=(240, 4))
+    y = (X[:, 0] > 0).astype(int) + (X[:, 1] > 0.5)
+    y[:1] = 7  # a single-member category: left out of the calibrated model
+    model = AffordancePredictor(kernel=kernel, random_state=0).fit(X, y)
+    fast = fast_predict_proba(model)
+    Xt = rng.normal(size=(30, 4))
+    assert np.allclose(fast(Xt), model.predict_proba(Xt), atol=1e-9)
+    binary = AffordancePredictor(calibration="sigmoid", random_state=0).fit(X, (X[:, 2] > 0).astype(int))
+    assert np.allclose(fast_predict_proba(binary)(Xt), binary.predict_proba(Xt), atol=1e-9)
