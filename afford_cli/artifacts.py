@@ -33,7 +33,7 @@ from afford_cli.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
-    "artifact_bytes", "TRUSTED_TYPES", "dump_estimator", "load_estimator",
+    "artifact_bytes", "TRUSTED_TYPES", "dump_estimator", "load_estimator", "check_output",
 ]
 
 FORMAT = "afford"
@@ -150,6 +150,25 @@ def artifact_bytes(kind: str, arrays: dict[str, np.ndarray], meta: dict[str, Any
     return buf.getvalue()
 
 
+def check_output(path: str) -> None:
+    """Fail before any work if ``path`` cannot take an artefact (``-`` always can)."""
+    if path == "-":
+        if sys.stdout.isatty():
+            raise AffordError("refusing to write an artefact to the terminal; give -o FILE or pipe it on")
+        return
+    if not path:
+        raise AffordError("give a file name for the artefact (-o FILE, or -o - for stdout)")
+    target = Path(path)
+    if target.is_dir():
+        raise AffordError(f"{path} is a directory; give a file name for the artefact")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        what = "is not a directory" if parent.exists() else "does not exist"
+        raise AffordError(f"cannot write {path}: {parent} {what}")
+    if not os.access(parent, os.W_OK):
+        raise AffordError(f"cannot write {path}: the directory {parent} is not writable")
+
+
 def write_artifact(path: str, data: bytes) -> None:
     """Write artefact bytes to ``path`` atomically, or to stdout for ``-``."""
     if path == "-":
@@ -213,6 +232,8 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise AffordError(f"{name} is not an afford file")
     kind = manifest.get("kind")
+    if kind not in KINDS:
+        raise AffordError(f"{name} is of an unknown artefact kind {kind!r}; it is corrupt or was edited")
     version = manifest.get("schema_version")
     if not isinstance(version, int):
         raise AffordError(f"{name} has no valid schema_version; it is corrupt or was edited")
@@ -226,7 +247,7 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
     if kinds is not None:
         wanted = (kinds,) if isinstance(kinds, str) else tuple(kinds)
         if kind not in wanted:
-            raise AffordError(f"{name} is a {kind!r} artefact, but this command needs {' or '.join(repr(k) for k in wanted)}")
+            raise AffordError(f"{name} is an artefact of kind {kind!r}, but this command needs {' or '.join(repr(k) for k in wanted)}")
     members = manifest.get("members")
     if not isinstance(members, dict):
         raise AffordError(f"{name} lists no members; it is corrupt or was edited")

@@ -22,8 +22,8 @@ DEFAULT_TOLERANCE = {"visibility": 0.5, "position": 0.05, "shape": 0.1}
 #: How far one unit of each channel counts in the search heuristic.
 SCALE = {"visibility": 1.0, "position": 0.1, "shape": 0.5}
 
-_EXPR = re.compile(r"^\s*(?P<obj>\*|\d+|\d+\s*-\s*\d+)\s*:\s*(?P<feat>[A-Za-z_][\w]*)\s*=\s*(?P<val>[-+]?[\d.eE+-]+)"
-                   r"\s*(~\s*(?P<rng>[\d.eE+-]+))?\s*$")
+_EXPR = re.compile(r"^\s*(?P<obj>\*|\d+|\d+\s*-\s*\d+)\s*:\s*(?P<feat>[A-Za-z_][\w]*)\s*=\s*(?P<val>[-+]?(?:[\d.eE+-]+|nan|inf))"
+                   r"\s*(~\s*(?P<rng>[-+]?(?:[\d.eE+-]+|nan|inf)))?\s*$", re.IGNORECASE)
 
 
 class GoalError(ValueError):
@@ -126,7 +126,7 @@ def parse_goal(expressions: list[str], schema: FeatureSchema) -> Goal:
             raise GoalError(f"goal {expr!r} has a value that is not a number") from None
         channel = schema.channels[feature]
         tol = DEFAULT_TOLERANCE.get(channel, 0.05) if tol is None else tol
-        if tol < 0 or not np.isfinite(value):
+        if not (np.isfinite(tol) and np.isfinite(value)) or tol < 0:
             raise GoalError(f"goal {expr!r}: the value must be finite and the range not negative")
         out.append(Constraint(obj, feature, schema.names[feature], value, tol, channel))
     return Goal(tuple(out))

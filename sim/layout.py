@@ -49,6 +49,8 @@ def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
     specs = []
     for i, item in enumerate(items):
         where = f"{source}, object {i}"
+        if not isinstance(item, dict):
+            raise LayoutError(f"{where}: each object must be an [[object]] table, not {type(item).__name__}")
         extra = set(item) - _KEYS
         if extra:
             raise LayoutError(f"{where}: unknown key {sorted(extra)[0]!r}; known keys: {', '.join(sorted(_KEYS))}")
@@ -64,9 +66,10 @@ def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
         held = item.get("held", False)
         if not isinstance(held, bool):
             raise LayoutError(f"{where}: held must be true or false")
+        size = _numbers(item["size"], "size", where)
+        position = _numbers(item["position"], "position", where)
         try:
-            specs.append(ObjectSpec(shape, _numbers(item["size"], "size", where),
-                                    _numbers(item["position"], "position", where), float(yaw), held))  # type: ignore[arg-type]
+            specs.append(ObjectSpec(shape, size, position, float(yaw), held))  # type: ignore[arg-type]
         except ValueError as exc:
             raise LayoutError(f"{where}: {exc}") from None
     if sum(s.held for s in specs) > 1:
@@ -75,13 +78,19 @@ def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
 
 
 def load_layout(path: str | Path) -> list[ObjectSpec]:
+    if str(path) in ("", "-"):
+        raise LayoutError("give a layout file name (layouts are not read from standard input)")
     p = Path(path)
     if not p.exists():
         raise LayoutError(f"layout file {path} does not exist")
+    if p.is_dir():
+        raise LayoutError(f"layout file {path} is a directory")
     try:
         text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise LayoutError(f"cannot read layout file {path} ({exc})") from None
+    except UnicodeDecodeError:
+        raise LayoutError(f"layout file {path} is not UTF-8 text") from None
+    except OSError as exc:
+        raise LayoutError(f"cannot read layout file {path} ({exc.strerror})") from None
     return parse_layout(text, str(path))
 
 

@@ -66,6 +66,8 @@ class ObjectSpec:
             raise ValueError(f"object sizes must be between 0.01 and 1.0 m, got {list(self.size)}")
         if len(self.position) != 2:
             raise ValueError("an object's position is [x, y] on the table")
+        if not all(math.isfinite(v) for v in (*self.size, *self.position, self.yaw)):
+            raise ValueError("an object's size, position and yaw must be finite numbers")
 
     @property
     def extents(self) -> np.ndarray:

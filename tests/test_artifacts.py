@@ -71,6 +71,13 @@ def test_not_an_afford_file(tmp_path, content):
         A.read_artifact(str(p))
 
 
+def test_an_unknown_kind_is_refused(tmp_path):
+    path = _write(tmp_path)
+    _rewrite(path, _manifest_edit(kind="banana"))
+    with pytest.raises(AffordError, match="unknown artefact kind 'banana'"):
+        A.read_artifact(str(path))
+
+
 def test_a_zip_that_is_not_ours(tmp_path):
     p = tmp_path / "other.zip"
     with zipfile.ZipFile(p, "w") as zf:
@@ -81,7 +88,7 @@ def test_a_zip_that_is_not_ours(tmp_path):
 
 def test_wrong_kind_for_the_command(tmp_path):
     path = _write(tmp_path, "model")
-    with pytest.raises(AffordError, match="is a 'model' artefact, but this command needs 'interactions'"):
+    with pytest.raises(AffordError, match="is an artefact of kind 'model', but this command needs 'interactions'"):
         A.read_artifact(str(path), "interactions")
 
 

@@ -68,7 +68,9 @@ def test_inspect_human_report_shows_the_same_tables(interactions):
     (["explore", "--episodes", "1", "--interactions", "1", "-o", "x.afford"], 2),
     (["explore", "--episodes", "1"], 2),
     (["explore", "--scene", "kitchen", "-o", "x.afford"], 1),
-    (["explore", "--episodes", "1", "--size-min", "0.3", "--size-max", "0.1", "-o", "x.afford"], 1),
+    (["explore", "--episodes", "1", "--size-min", "0.3", "--size-max", "0.1", "-o", "x.afford"], 2),
+    (["explore", "--episodes", "1", "--size-min", "0", "-o", "x.afford"], 2),
+    (["explore", "--episodes", "1", "-o", ""], 1),
     (["inspect", "does-not-exist.afford"], 1),
 ])
 def test_bad_input_exit_codes(tmp_path, monkeypatch, args, code):
@@ -121,3 +123,20 @@ def test_an_existing_file_survives_a_failed_run(tmp_path, interactions):
     result = runner.invoke(app, ["explore", "--scene", "kitchen", "-o", str(target)])
     assert result.exit_code == 1
     assert target.read_bytes() == path.read_bytes()
+
+
+@pytest.mark.parametrize("text, message", [
+    ("object = [1, 2]", "must be an [[object]] table"),
+    ('[[object]]\nshape = "box"\nsize = "big"\nposition = [0.6, 0.0]\n', "object 0: size must be a list of numbers"),
+    ('[[object]]\nshape = "box"\nsize = [0.1, 0.1, 0.1]\nposition = [0.6, 0.0]\nyaw = nan\n', "must be finite"),
+    ('[[object]]\nshape = "cone"\nsize = [0.1]\nposition = [0.6, 0.0]\n', "unknown shape 'cone'"),
+])
+def test_bad_layouts_are_one_sentence(tmp_path, text, message):
+    from sim.layout import LayoutError, load_layout
+
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(LayoutError) as info:
+        load_layout(path)
+    assert message in str(info.value)
+    assert str(info.value).count(str(path)) == 1

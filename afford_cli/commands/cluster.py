@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
 from afford_cli.learning import effects_members, read_rows
 from afford_cli.options import InputPath, Json, OutputPath, Seed
 from afford_cli.output import Output
@@ -40,6 +40,7 @@ def cluster(
 
     if k is not None and method is not Method.kmeans:
         raise typer.BadParameter("--k goes with --method kmeans")
+    check_output(output)
     out = Output(json, stdout_busy=output == "-")
     art, data = read_rows(path)
     start = time.perf_counter()

@@ -6,7 +6,7 @@ import time
 from typing import Annotated, Optional
 
 import typer
-from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
 from afford_cli.datasets import behaviour_counts, interactions_members, outcome_table
 from afford_cli.reports import render_outcome_table
 from afford_cli.errors import AffordError
@@ -78,6 +78,12 @@ def explore(
         raise typer.BadParameter("give --episodes or --interactions, not both")
     if episodes is None and interactions is None:
         episodes = 100
+    for name, value in (("--size-min", size_min), ("--size-max", size_max)):
+        if value is not None and not (0.02 <= value <= 0.6):
+            raise typer.BadParameter(f"{name} must be between 0.02 and 0.6 m, got {value}")
+    if size_min is not None and size_max is not None and size_min > size_max:
+        raise typer.BadParameter(f"--size-min ({size_min}) is larger than --size-max ({size_max})")
+    check_output(output)
     out = Output(json, stdout_busy=output == "-")
     sc = make_scene(scene, size_min, size_max)
     data, seconds = run_explore(out, sc, episodes=episodes, interactions=interactions, seed=seed,

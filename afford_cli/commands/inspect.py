@@ -5,6 +5,7 @@ from __future__ import annotations
 from rich.table import Table
 
 from afford_cli.artifacts import Artifact, read_artifact
+from afford_cli.errors import AffordError
 from afford_cli.datasets import behaviour_counts, interactions_from_artifact, outcome_table
 from afford_cli.options import InputPath, Json
 from afford_cli.output import Output

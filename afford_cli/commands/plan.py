@@ -98,6 +98,8 @@ def plan(
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
     if layout is not None and episodes > 1:
         raise typer.BadParameter("--episodes draws random scenes; it does not go with --layout")
+    if layout is None and seed is None:
+        raise typer.BadParameter("give --layout FILE, or --seed S to draw a random scene")
     loaded = load_model(model)
     fm = forward_model(loaded)
     g = parse_goals(goal, loaded.schema)

@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 from rich.table import Table
 
-from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
 from afford_cli.learning import features_members, read_effects, read_rows
 from afford_cli.options import InputPath, Json, OutputPath, Seed
 from afford_cli.output import Output
@@ -33,6 +33,7 @@ def select_features(
     """Rank the object features by relevance to each behaviour's effect categories."""
     from learn.affordances import rank_features
 
+    check_output(output)
     out = Output(json, stdout_busy=output == "-")
     art, data = read_rows(path, ("effects", "features"))
     labels, _ = read_effects(art, data)

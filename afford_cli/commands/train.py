@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from afford_cli.artifacts import artifact_bytes, write_artifact
+from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
 from afford_cli.learning import model_members, read_effects, read_rows, read_selection
 from afford_cli.options import InputPath, Json, OutputPath, Seed
 from afford_cli.output import Output
@@ -30,6 +30,7 @@ def train(
     """Train each behaviour's effect-category predictor (thesis 8.4.2), probabilities calibrated."""
     from learn.affordances import train_known, train_predictors
 
+    check_output(output)
     out = Output(json, stdout_busy=output == "-")
     art, data = read_rows(path, ("effects", "features"))
     labels, effects = read_effects(art, data)
