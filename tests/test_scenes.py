@@ -75,3 +75,16 @@ def test_sizes_follow_the_configured_range():
     assert sizes.min() >= 0.05 and sizes.max() <= 0.06
     with pytest.raises(ValueError, match="object sizes"):
         replace(cls().config, size_range=(0.3, 0.1))
+
+
+def test_layouts_must_stand_on_the_table():
+    from sim.objects import ObjectSpec
+
+    scene = get_scene("table")()
+    scene.check_layout([ObjectSpec("box", (0.1, 0.1, 0.1), (0.6, 0.0))])
+    with pytest.raises(ValueError, match="not on the table"):
+        scene.check_layout([ObjectSpec("box", (0.1, 0.1, 0.1), (0.2, 0.0))])
+    with pytest.raises(ValueError, match="hangs over the table's edge"):
+        scene.check_layout([ObjectSpec("box", (0.9, 0.9, 0.1), (0.41, 0.49))])
+    with pytest.raises(ValueError, match="overlap"):
+        scene.check_layout([ObjectSpec("box", (0.1, 0.1, 0.1), (0.6, 0.0)), ObjectSpec("box", (0.1, 0.1, 0.1), (0.62, 0.0))])

@@ -96,8 +96,8 @@ def plan(
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
-    if layout is not None and episodes > 1:
-        raise typer.BadParameter("--episodes draws random scenes; it does not go with --layout")
+    if layout is not None and (episodes > 1 or reachable or seed is not None or objects != 1):
+        raise typer.BadParameter("--layout pins the scene; it does not go with --seed, --objects, --reachable or --episodes")
     if layout is None and seed is None:
         raise typer.BadParameter("give --layout FILE, or --seed S to draw a random scene")
     loaded = load_model(model)

@@ -74,8 +74,8 @@ def predict(
     json: Json = False,
 ) -> None:
     """Predict, for every object the robot sees, what each behaviour would do to it."""
-    if layout is not None and seed is not None and objects != 1:
-        raise typer.BadParameter("--objects draws a random scene; it does not go with --layout")
+    if layout is not None and (seed is not None or objects != 1):
+        raise typer.BadParameter("--layout pins the scene; it does not go with --seed or --objects")
     if layout is None and seed is None:
         raise typer.BadParameter("give --layout FILE, or --seed S to draw a random scene")
     loaded = load_model(model)

@@ -131,6 +131,13 @@ class TableScene:
             if not (w.table_near <= x <= w.table_far and -w.table_width / 2 <= y <= w.table_width / 2):
                 raise ValueError(f"object {i} at ({x}, {y}) is not on the table "
                                  f"(x {w.table_near}..{w.table_far}, y {-w.table_width / 2}..{w.table_width / 2})")
+            th = math.radians(o.yaw)
+            e = o.extents
+            hx = (abs(math.cos(th)) * e[0] + abs(math.sin(th)) * e[1]) / 2
+            hy = (abs(math.sin(th)) * e[0] + abs(math.cos(th)) * e[1]) / 2
+            if (x - hx < w.table_near - 0.01 or x + hx > w.table_far + 0.01
+                    or abs(y) + hy > w.table_width / 2 + 0.01) and not o.held:
+                raise ValueError(f"object {i} at ({x}, {y}) hangs over the table's edge; move it inwards")
         for i, a in enumerate(objects):
             for j in range(i + 1, len(objects)):
                 b = objects[j]
