@@ -9,7 +9,6 @@ from __future__ import annotations
 import functools
 import os
 import sys
-import warnings
 from typing import Callable
 
 import typer
@@ -53,13 +52,8 @@ for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
     app.command(_name)(_guarded(_command))
 
 
-def _quiet_libraries() -> None:
-    warnings.filterwarnings("ignore", message="Failed to find system libvulkan")
-
-
 def main(argv: list[str] | None = None) -> None:
     """Console entry point."""
-    _quiet_libraries()
     try:
         app(args=argv)
     except KeyboardInterrupt:

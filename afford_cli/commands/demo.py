@@ -11,8 +11,6 @@ from typing import Annotated
 
 import typer
 
-from afford_cli.artifacts import artifact_bytes, write_artifact
-from afford_cli.datasets import interactions_members
 from afford_cli.options import Seed, Workers
 from afford_cli.output import Output
 
@@ -31,12 +29,8 @@ def demo(
     path = {k: str(out_dir / f"{k}.afford") for k in ("interactions", "heldout", "effects", "features", "model")}
 
     console.rule(f"[bold]1. explore: the robot pushes and lifts random objects ({interactions} interactions)")
-    scene = explore.make_scene("table")
-    data, seconds = explore.run_explore(Output(), scene, episodes=None, interactions=interactions, seed=seed,
-                                        workers=workers, max_steps=10)
-    arrays, meta = interactions_members(data)
-    write_artifact(path["interactions"], artifact_bytes("interactions", arrays, meta, seed=seed))
-    s = explore.summary(data, seconds)
+    _, s = explore.record(Output(), explore.make_scene("table"), path["interactions"], episodes=None,
+                          interactions=interactions, seed=seed, workers=workers)
     console.print(f"recorded {s['interactions']} interactions in {s['episodes']} episodes "
                   f"({s['interactions_per_second']}/s) -> {path['interactions']}; what the file holds, verified:")
     inspect.inspect(path["interactions"])

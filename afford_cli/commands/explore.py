@@ -61,6 +61,20 @@ def summary(data, seconds: float) -> dict:
     }
 
 
+def record(out: Output, scene, output: str, *, episodes: int | None, interactions: int | None, seed: int,
+           workers: int, max_steps: int = 10):
+    """Explore, write the ``interactions`` artefact to ``output``; returns (data, summary)."""
+    data, seconds = run_explore(out, scene, episodes=episodes, interactions=interactions, seed=seed,
+                                workers=workers, max_steps=max_steps)
+    if len(data) == 0:
+        raise AffordError("exploration recorded no interactions (no object was ever seen)")
+    arrays, meta = interactions_members(data)
+    write_artifact(output, artifact_bytes("interactions", arrays, meta, seed=seed))
+    result = summary(data, seconds)
+    result["output"] = output
+    return data, result
+
+
 def explore(
     output: OutputPath,
     scene: SceneName = "table",
@@ -86,14 +100,8 @@ def explore(
     check_output(output)
     out = Output(json, stdout_busy=output == "-")
     sc = make_scene(scene, size_min, size_max)
-    data, seconds = run_explore(out, sc, episodes=episodes, interactions=interactions, seed=seed,
-                                workers=workers, max_steps=max_steps)
-    if len(data) == 0:
-        raise AffordError("exploration recorded no interactions (no object was ever seen)")
-    arrays, meta = interactions_members(data)
-    write_artifact(output, artifact_bytes("interactions", arrays, meta, seed=seed))
-    result = summary(data, seconds)
-    result["output"] = output
+    data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
+                          workers=workers, max_steps=max_steps)
 
     def render(console):
         console.print(f"[bold]explored[/] {result['interactions']} interactions in {result['episodes']} episodes, "
