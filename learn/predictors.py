@@ -85,7 +85,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         ``"rbf"``: :class:`~sklearn.svm.SVC` (libsvm, as the thesis). ``"linear"``:
         :class:`~sklearn.svm.LinearSVC` solved in the primal (liblinear, squared hinge),
         which takes milliseconds where libsvm's linear kernel takes seconds at C = 100.
-    C_grid : tuple of float, default=(0.1, 1.0, 10.0, 100.0)
+    C_grid : tuple of float, default=(0.1, 1.0, 10.0, 100.0, 1000.0)
     gamma_grid : tuple of float or None, default=None
         RBF widths to try. None: ``(0.1, 1, 10) / n_features``. Ignored for ``"linear"``.
     cv : int, default=3
@@ -138,7 +138,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         "random_state": ["random_state"],
     }
 
-    def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0), gamma_grid=None, cv=3,
+    def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0, 1000.0), gamma_grid=None, cv=3,
                  calibration="temperature", ensemble=False, n_jobs=None, random_state=None):
         self.ensemble = ensemble
         self.kernel = kernel

@@ -42,7 +42,7 @@ from sklearn.utils.validation import check_array, check_is_fitted, validate_data
 from features.schema import FeatureSchema
 from learn.xmeans import _check_finite
 
-__all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "relieff"]
+__all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "ranking_prefix", "relieff"]
 
 # Rows of sampled instances whose distances to all rows are computed at once (memory bound).
 _CHUNK = 256
@@ -277,6 +277,74 @@ def _score_changes(evaluator, units, sign, n_jobs):
     return Parallel(n_jobs=n_jobs, prefer="threads")(delayed(evaluator.accuracy_changed)(u, sign) for u in units)
 
 
+def _prefix_sizes(d: int) -> list[int]:
+    """Candidate prefix lengths: every size up to 4, then about a third more each time."""
+    sizes, k = [], 1
+    while k < d:
+        sizes.append(k)
+        k = k + 1 if k < 4 else int(round(k * 4 / 3))
+    return sizes + [d]
+
+
+def ranking_prefix(X, y, ranking, estimator=None, cv=3, random_state=None, n_jobs=None):
+    """How many of the best-ranked features to keep, by cross-validated accuracy.
+
+    A filter ranks but does not say where to stop. Prefixes of ``ranking`` of growing
+    length (1, 2, 3, 4, then about a third longer each time, and all) are scored by
+    stratified cross-validation (the same folds for each), and the shortest prefix whose
+    accuracy is within one standard error of the best one is kept: noisy features dilute
+    an RBF kernel's distances, so a short prefix often predicts better than all of them.
+
+    Parameters
+    ----------
+    X : array-like of shape (n_rows, n_features)
+    y : array-like of shape (n_rows,)
+    ranking : array-like of int
+        Feature indices, most relevant first.
+    estimator : classifier or None, default=None
+        None: an RBF SVM (C=100, ``gamma="scale"``) on standardised features, the
+        predictor ``afford train`` fits, without its grid search.
+    cv : int, default=3
+    random_state : int, RandomState instance or None, default=None
+        Seeds the folds.
+    n_jobs : int or None, default=None
+
+    Returns
+    -------
+    k : int
+        Number of features to keep.
+    path : list of dict
+        ``{"k": int, "accuracy": float, "sem": float}`` per prefix scored.
+    """
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+    from sklearn.svm import SVC
+
+    X, y, _, y_idx = _check_Xy(X, y)
+    ranking = np.asarray(ranking, dtype=int)
+    if estimator is None:
+        estimator = make_pipeline(StandardScaler(), SVC(C=100.0, gamma="scale"))
+    folds = _folds(y_idx, cv, check_random_state(random_state).randint(np.iinfo(np.int32).max))
+    sizes = _prefix_sizes(ranking.size)
+
+    def score(k, train, test):
+        cols = ranking[:k]
+        model = clone(estimator).fit(X[train][:, cols], y_idx[train])
+        return float(np.mean(model.predict(X[test][:, cols]) == y_idx[test]))
+
+    jobs = [(k, tr, te) for k in sizes for tr, te in folds]
+    if n_jobs in (None, 1):
+        scores = [score(*job) for job in jobs]
+    else:
+        scores = Parallel(n_jobs=n_jobs)(delayed(score)(*job) for job in jobs)
+    acc = np.asarray(scores).reshape(len(sizes), len(folds))
+    mean, sem = acc.mean(axis=1), acc.std(axis=1) / np.sqrt(len(folds))
+    best = int(np.argmax(mean))
+    k = next(s for s, m in zip(sizes, mean) if m >= mean[best] - sem[best])
+    path = [{"k": s, "accuracy": float(m), "sem": float(e)} for s, m, e in zip(sizes, mean, sem)]
+    return k, path
+
+
 def forward_selection(X, y, estimator=None, cv=5, max_features=None, groups=None, tol=0.0,
                       random_state=None, n_jobs=None):
     """Greedy forward selection with cross-validation (the thesis's ``sequentialfs``).
@@ -411,17 +479,19 @@ class FeatureRelevance(BaseEstimator):
     ----------
     method : {"relieff", "forward", "backward"}, default="relieff"
     top : int or None, default=None
-        Number of features to select, best first. None: ReliefF selects the features whose
-        weight exceeds a tenth of the largest weight; the wrappers select what their
-        stopping rule keeps.
+        Number of features to select, best first. None: ReliefF keeps the shortest prefix
+        of its ranking whose cross-validated accuracy is within one standard error of the
+        best prefix (:func:`ranking_prefix`, with ``estimator``, ``cv`` and ``n_jobs``);
+        the wrappers select what their stopping rule keeps.
     n_samples : int, default=1000
         ReliefF's ``m``.
     n_neighbors : int, default=10
         ReliefF's ``k``.
     estimator : classifier or None, default=None
-        Wrappers' classifier (None: 10-NN on standardised features).
+        Wrappers' classifier (None: 10-NN on standardised features), and the classifier
+        that scores ReliefF's ranking prefixes (None: an RBF SVM, see :func:`ranking_prefix`).
     cv : int, default=5
-        Wrappers' stratified folds.
+        Wrappers' stratified folds (ReliefF's prefix choice uses at most 3).
     feature_groups : array-like of shape (n_features,) or None, default=None
         Wrappers move a group of features as one unit (see :func:`feature_groups`).
     tol : float or None, default=None
@@ -443,7 +513,8 @@ class FeatureRelevance(BaseEstimator):
         Indices of the selected features, most relevant first; never empty (when no
         feature beats the majority vote the best-ranked unit is kept).
     path_ : list of dict
-        Wrappers' accuracy after every step (empty for ReliefF).
+        Wrappers' accuracy after every step; ReliefF's accuracy of every ranking prefix
+        scored (empty when ``top`` is given).
     n_features_in_ : int
 
     Examples
@@ -508,9 +579,9 @@ class FeatureRelevance(BaseEstimator):
             self.scores_ = relieff(X, y, self.n_samples, self.n_neighbors, self.random_state)
             self.ranking_ = np.argsort(-self.scores_, kind="stable")
             if self.top is None:
-                best = self.scores_[self.ranking_[0]]
-                chosen = self.ranking_[self.scores_[self.ranking_] > max(0.1 * best, 0.0)]
-                self.selected_ = chosen if chosen.size else self.ranking_[:1]
+                k, self.path_ = ranking_prefix(X, y, self.ranking_, self.estimator, min(self.cv, 3),
+                                               self.random_state, self.n_jobs)
+                self.selected_ = self.ranking_[:k]
             else:
                 self.selected_ = self.ranking_[: self.top]
             return self
