@@ -73,6 +73,17 @@ class Goal:
         """Scaled distance to the goal: 0 exactly when it holds (the search heuristic)."""
         return float(sum(c.gaps(state).min() / SCALE.get(c.channel, 1.0) for c in self.constraints))
 
+    def min_steps(self, state: np.ndarray) -> int:
+        """A lower bound on the steps still needed: a behaviour changes one object only.
+
+        Every named object with an unmet constraint needs a step of its own, and so does an
+        unmet relative constraint neither of whose objects is among them (``*`` constraints
+        add nothing: a step on any object might meet them).
+        """
+        named = {c.obj for c in self.constraints if isinstance(c.obj, int) and not c.holds(state)}
+        pairs = [c.obj for c in self.constraints if isinstance(c.obj, tuple) and not c.holds(state)]
+        return len(named) + int(any(a not in named and b not in named for a, b in pairs))
+
     @property
     def channels(self) -> set[str]:
         return {c.channel for c in self.constraints}

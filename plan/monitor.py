@@ -12,7 +12,7 @@ prediction would otherwise send it round in circles).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Callable, Protocol
 
 import numpy as np
 
@@ -20,7 +20,7 @@ from plan.forward import ForwardModel
 from plan.goals import DEFAULT_TOLERANCE, Goal
 from plan.search import Plan, search
 
-__all__ = ["World", "Execution", "execute", "mismatch"]
+__all__ = ["World", "Execution", "assess", "execute", "mismatch", "reach_probability"]
 
 
 class World(Protocol):
@@ -61,10 +61,18 @@ def mismatch(goal: Goal, predicted: np.ndarray, perceived: np.ndarray, position_
 
 
 def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "best-first", max_replans: int = 3,
-            first: Plan | None = None, **limits) -> Execution:
-    """Plan (unless ``first`` is given), execute step by step, replan on surprises."""
+            first: Plan | None = None, planner: Callable[[np.ndarray, tuple], Plan] | None = None,
+            **limits) -> Execution:
+    """Plan (unless ``first`` is given), execute step by step, replan on surprises.
+
+    ``planner(state, avoid)`` replaces the search (with ``method`` and ``limits``) where given.
+    """
+    if planner is None:
+        def planner(state: np.ndarray, avoid: tuple) -> Plan:
+            return search(model, state, goal, method, avoid=avoid, **limits)
+
     state = world.perceive()
-    plan = first if first is not None else search(model, state, goal, method, **limits)
+    plan = first if first is not None else planner(state, ())
     run = Execution(False, [plan])
     failed: list[tuple[np.ndarray, str, int]] = []  # (object seen before, behaviour, object) that surprised
     while True:
@@ -97,5 +105,95 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
         run.replans += 1
         # Behaviours that surprised the robot cost more in the new search: the model would
         # predict the same again, and the robot go round in circles.
-        plan = search(model, state, goal, method, avoid=tuple(failed), **limits)
+        plan = planner(state, tuple(failed))
         run.plans.append(plan)
+
+
+class _Imagined:
+    """The world as the model predicts it, for :func:`reach_probability`.
+
+    A step's outcome is drawn from the model's distribution; the same behaviour on the same
+    object vector gives the same outcome again (the world is not a die: a push that left an
+    object where it was will leave it there again), so a rollout is one world the model
+    thinks possible. An outcome of a kind the model does not know (the probability it gives
+    to none of its categories) leaves the object as it was.
+    """
+
+    def __init__(self, model: ForwardModel, state: np.ndarray, rng: np.random.Generator):
+        self.model, self.state, self.rng = model, state.copy(), rng
+        self.fate: dict = {}
+
+    def perceive(self) -> np.ndarray:
+        return self.state.copy()
+
+    def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:
+        b = self.model.index(behavior)
+        alpha_key = tuple(float(a) for a in (() if alpha is None else alpha))
+        key = (self.state[target].tobytes(), b, alpha_key)
+        if key not in self.fate:
+            classes, proba = self.model.distribution(self.state[target], b, alpha_key)
+            edges = np.cumsum(proba)
+            r = self.rng.random()
+            self.fate[key] = int(classes[min(np.searchsorted(edges, r, side="right"), len(classes) - 1)]) \
+                if edges.size and r < edges[-1] else None
+        if self.fate[key] is not None and self.state[target, 0] >= 0.5:
+            self.state = self.model.apply(self.state, target, b, self.fate[key])
+        return self.perceive()
+
+
+def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int = 3,
+                      method: str = "best-first", rollouts: int = 100, seed: int = 0, imagined_nodes: int = 2000,
+                      **limits) -> float:
+    """P(reaching the goal by running ``plan`` the way :func:`execute` does), by the model.
+
+    The open-loop probability (:func:`plan.search.success_probability`) answers for the
+    plan run blind; a robot that monitors its steps and replans when one surprises it (up
+    to ``max_replans`` times) reaches the goal more often than that. This runs
+    :func:`execute` itself, ``rollouts`` times, in worlds drawn from the model
+    (:class:`_Imagined`), and returns the fraction that reached the goal: replanning,
+    distrust of behaviours that surprised and the replan budget all count as they will
+    when the plan runs for real. Outcomes stay put within a rollout (retrying what failed on
+    an object that did not move fails again), so it is not the independent-retries
+    arithmetic, which would count a failed push as a coin to toss again. The same
+    ``seed`` gives the same figure; its standard error is at most ``0.5 / sqrt(rollouts)``.
+
+    Imagined replans search with at most ``imagined_nodes`` expansions (a search that finds
+    nothing spends its whole budget, and imagined rollouts meet many hopeless states); a
+    replan that would need more counts as failed, so the figure errs low there.
+    """
+    limits = {**limits, "max_nodes": min(limits.get("max_nodes", imagined_nodes), imagined_nodes)}
+    if goal.holds(start):
+        return 1.0
+    if not plan.found:
+        return 0.0
+    rng = np.random.default_rng(seed)
+    plans: dict = {}
+
+    def planner(state: np.ndarray, avoid: tuple) -> Plan:
+        key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o) for f, b, o in avoid))
+        if key not in plans:
+            plans[key] = search(model, state, goal, method, avoid=avoid, **limits)
+        return plans[key]
+
+    reached = 0
+    for _ in range(rollouts):
+        world = _Imagined(model, start, rng)
+        reached += execute(world, model, goal, method=method, max_replans=max_replans, first=plan,
+                           planner=planner).reached
+    return reached / rollouts
+
+def assess(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int = 3,
+           method: str = "best-first", rollouts: int = 100, seed: int = 0, **limits) -> Plan:
+    """Make ``plan.success_probability`` the chance of reaching the goal with monitoring
+    (:func:`reach_probability`).
+
+    The open-loop figure stays in ``plan.open_loop_probability``; ``limits`` are the
+    search limits replanning would use.
+    """
+    if plan.open_loop_probability is None:
+        plan.open_loop_probability = plan.success_probability
+    if plan.found:
+        plan.success_probability = reach_probability(model, start, goal, plan, max_replans=max_replans,
+                                                     method=method, rollouts=rollouts, seed=seed, **limits)
+    plan.replans_assumed = max_replans
+    return plan

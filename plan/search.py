@@ -7,9 +7,12 @@ node nearer the goal), so with the default weight of 0 the first plan that reach
 goal is the most probable one within the limits. ``breadth_first`` is the thesis's forward
 chaining: only each behaviour's most probable outcome, shortest plan first.
 
-A plan's *success probability* is the chance that executing its behaviours open-loop
+A plan's *open-loop probability* is the chance that executing its behaviours blind
 reaches the goal at some step, summed over every outcome sequence the model predicts (not
-only the one the plan was found along).
+only the one the plan was found along). A search reports it as the plan's success
+probability; :func:`plan.monitor.assess` replaces that with the chance of reaching the goal
+when the plan runs with monitoring and replanning, as ``afford plan`` and ``afford
+emulate`` run it.
 """
 
 from __future__ import annotations
@@ -46,17 +49,21 @@ class Plan:
     found: bool
     steps: list[PlanStep] = field(default_factory=list)
     path_probability: float = 0.0      # product of the step probabilities along the plan
-    success_probability: float = 0.0   # open-loop chance of reaching the goal
+    success_probability: float = 0.0   # chance of reaching the goal (open-loop, until assessed)
     expanded: int = 0
     generated: int = 0
     seconds: float = 0.0
     reason: str = ""
     tree: list[dict] = field(default_factory=list)  # the first levels of the search, for reports
+    open_loop_probability: float | None = None  # set with success_probability by the search
+    replans_assumed: int = 0  # success_probability assumes monitoring with this many replans
 
     def to_json(self) -> dict:
+        open_loop = self.success_probability if self.open_loop_probability is None else self.open_loop_probability
         return {"found": self.found, "steps": [s.to_json() for s in self.steps], "length": len(self.steps),
                 "path_probability": round(self.path_probability, 4),
                 "success_probability": round(self.success_probability, 4),
+                "open_loop_probability": round(open_loop, 4), "replans_assumed": self.replans_assumed,
                 "expanded": self.expanded, "generated": self.generated, "seconds": round(self.seconds, 4),
                 "reason": self.reason}
 
@@ -154,6 +161,8 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                 generated += 1
                 if _no_op(state, out.state, obj):
                     continue  # an outcome that changes nothing cannot be part of a shortest way
+                if len(steps) + 1 + goal.min_steps(out.state) > max_depth:
+                    continue  # too many objects still to change in the steps left
                 c = cost - math.log(max(out.probability, 1e-12)) + penalty
                 k = _key(out.state)
                 if best_cost.get(k, math.inf) <= c + 1e-12:
@@ -195,7 +204,7 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                     continue
                 out = outs[0]
                 generated += 1
-                if _no_op(state, out.state, obj):
+                if _no_op(state, out.state, obj) or len(steps) + 1 + goal.min_steps(out.state) > max_depth:
                     continue
                 k = _key(out.state)
                 if k in seen:

@@ -9,7 +9,7 @@ from features import object_schema
 from plan.emulate import goal_from_observation
 from plan.forward import BehaviorModel, ForwardModel
 from plan.goals import GoalError, parse_goal
-from plan.monitor import execute
+from plan.monitor import assess, execute, reach_probability
 from plan.search import best_first, breadth_first, inverse_query, success_probability
 
 SCHEMA = object_schema()
@@ -212,3 +212,46 @@ def test_unknown_effects_lower_the_probabilities_plans_count_on():
     assert out.probability == pytest.approx(0.25)  # the rest is an outcome no plan counts on
     plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
     assert [s.behavior for s in plan.steps] == ["sweep"]
+
+
+PUSH_HALF = behaviour("push", [(0.6, effect(0.2)), (0.4, effect())])
+SLIDE = behaviour("slide", [(0.5, effect(0.2)), (0.5, effect())])
+
+
+def test_reach_probability_imagines_monitored_execution():
+    g = goal("0:x_min=0.4~0.01")
+    fm = ForwardModel([PUSH_HALF])
+    plan = best_first(fm, scene(0.0), g)
+    assert [s.behavior for s in plan.steps] == ["push", "push"]
+    assert plan.success_probability == pytest.approx(0.36)  # both pushes must work, blind
+    n = 1000
+    se = 3 * np.sqrt(0.36 * 0.64 / n)
+    # no replans: the open-loop figure, by sampling
+    assert reach_probability(fm, scene(0.0), g, plan, max_replans=0, rollouts=n) == pytest.approx(0.36, abs=se)
+    # A push that left the object where it was leaves it there again: with nothing else to
+    # try, replanning cannot help (independent retries would claim 0.91).
+    assert reach_probability(fm, scene(0.0), g, plan, max_replans=3, rollouts=n) == pytest.approx(0.36, abs=se)
+    # With another behaviour to turn to, monitoring and replanning do help.
+    both = ForwardModel([PUSH_HALF, SLIDE])
+    plan = best_first(both, scene(0.0), g)
+    assert [s.behavior for s in plan.steps] == ["push", "push"]
+    monitored = reach_probability(both, scene(0.0), g, plan, max_replans=3, rollouts=n, seed=1)
+    assert monitored > 0.36 + 0.15
+    assert reach_probability(both, scene(0.0), g, plan, max_replans=3, rollouts=n, seed=1) == monitored
+    assessed = assess(both, scene(0.0), g, plan, max_replans=3, rollouts=n, seed=1)
+    assert assessed.success_probability == monitored
+    assert assessed.to_json()["open_loop_probability"] == pytest.approx(0.36)
+    assert assessed.to_json()["replans_assumed"] == 3
+
+
+def test_min_steps_bounds_the_steps_left_and_prunes_hopeless_branches():
+    g = goal("0:visibility=0", "1:visibility=0", "2-3:x_min=0~0.01", "*:x_min=5~0.01")
+    state = scene(0.0, 0.0, 0.0, 0.3)
+    assert g.min_steps(state) == 3  # objects 0 and 1, and one of 2 and 3
+    state[0, 0] = 0.0
+    assert g.min_steps(state) == 2
+    fm = ForwardModel([SWEEP])
+    three = goal("0:visibility=0", "1:visibility=0", "2:visibility=0")
+    shallow = best_first(fm, scene(0.0, 0.5, 1.0), three, max_depth=2)
+    assert not shallow.found and shallow.expanded == 1  # no child can finish in time
+    assert best_first(fm, scene(0.0, 0.5, 1.0), three, max_depth=3).found

@@ -29,6 +29,7 @@ def emulate(
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
     from plan.emulate import goal_from_observation
+    from plan.monitor import assess
     from plan.monitor import execute as run
     from plan.search import search
 
@@ -44,13 +45,15 @@ def emulate(
         goal = goal_from_observation(observed, state, loaded.schema)
     except ValueError as exc:
         raise AffordError(str(exc)) from None
-    plan = search(fm, state, goal, "best-first", max_depth=max_depth, max_nodes=max_nodes)
+    limits = {"max_depth": max_depth, "max_nodes": max_nodes}
+    plan = assess(fm, state, goal, search(fm, state, goal, "best-first", **limits), max_replans=max_replans, **limits)
     result = {"goal": goal.to_json(), "plan": plan.to_json()["steps"], "found": plan.found,
-              "success_probability": round(plan.success_probability, 4), "reached": False, "replans": 0,
+              "success_probability": round(plan.success_probability, 4),
+              "open_loop_probability": plan.to_json()["open_loop_probability"], "reached": False, "replans": 0,
               "search": plan.to_json()}
     entry = {"plan": plan.to_json(), "tree": plan.tree[:8]}
     if execute and plan.found:
-        ex = run(world, fm, goal, max_replans=max_replans, first=plan, max_depth=max_depth, max_nodes=max_nodes)
+        ex = run(world, fm, goal, max_replans=max_replans, first=plan, **limits)
         result.update({"reached": ex.reached, "replans": ex.replans, "execution": ex.to_json()})
         entry["execution"] = ex.to_json()
     elif not plan.found:

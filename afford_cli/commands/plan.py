@@ -33,6 +33,7 @@ def parse_goals(expressions: list[str], schema):
 
 def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int) -> dict:
     """Plan in one scene (and execute with monitoring); the result as plain data."""
+    from plan.monitor import assess
     from plan.monitor import execute as run
     from plan.search import search
 
@@ -40,7 +41,8 @@ def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dic
     start = world.perceive()
     model.check_schema(scene.schema, "this scene's perception")
     goal.check_objects(start.shape[0])
-    first = search(fm, start, goal, method, **limits)
+    first = assess(fm, start, goal, search(fm, start, goal, method, **limits), max_replans=max_replans,
+                   method=method, **limits)
     out = {"seed": seed, "objects": start.shape[0], "plan": first.to_json(), "tree": first.tree[:12]}
     if execute and first.found:
         result = run(world, fm, goal, method=method, max_replans=max_replans, first=first, **limits)
@@ -59,6 +61,8 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
         console.print(f"[red]no plan[/]: {p['reason']} ({p['expanded']} nodes expanded, {p['seconds']:.2f} s)")
         return
     table = Table(title=f"plan: {p['length']} steps, success probability {p['success_probability']:.2f} "
+                        f"with monitoring and up to {p['replans_assumed']} replans, "
+                        f"{p['open_loop_probability']:.2f} run blind "
                         f"({p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms)", box=box.SIMPLE_HEAD)
     for col in ("step", "behaviour", "object", "alpha", "expected category", "p"):
         table.add_column(col)
@@ -136,7 +140,7 @@ def plan(
 
 def summarise(entries: list[dict], executed: bool) -> dict:
     by_length: dict[str, dict] = {}
-    probs, first_ok = [], []
+    probs, blind, first_ok = [], [], []
     for e in entries:
         p = e["plan"]
         if not p["found"]:
@@ -145,6 +149,7 @@ def summarise(entries: list[dict], executed: bool) -> dict:
         slot = by_length.setdefault(key, {"found": 0, "reached": 0})
         slot["found"] += 1
         probs.append(p["success_probability"])
+        blind.append(p["open_loop_probability"])
         if executed:
             slot["reached"] += int(e.get("reached", False))
             first_ok.append(bool(e.get("first_plan_worked", False)))
@@ -152,6 +157,7 @@ def summarise(entries: list[dict], executed: bool) -> dict:
     planned = [e for e in entries if "skipped" not in e]
     out = {"episodes": len(entries), "skipped": len(entries) - len(planned), "found": found, "by_length": dict(sorted(by_length.items(), key=lambda kv: int(kv[0]))),
            "mean_success_probability": round(float(np.mean(probs)), 4) if probs else None,
+           "mean_open_loop_probability": round(float(np.mean(blind)), 4) if blind else None,
            "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in planned] or [0.0])), 4),
            "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in planned] or [0.0])), 1)}
     if executed:
@@ -172,7 +178,9 @@ def render_summary(console, result: dict) -> None:
         table.add_row(k, str(v["found"]), str(v["reached"]) if "reached" in result else "-", rate)
     console.print(table)
     if result["mean_success_probability"] is not None:
-        console.print(f"mean predicted success probability {result['mean_success_probability']:.2f}"
-                      + (f"; first plans that worked without replanning: {result['first_plan_worked']} of {result['found']}"
+        reached = (f" (goal reached in {result['reached']} of {result['found']})" if "reached" in result else "")
+        console.print(f"mean predicted success probability with monitoring {result['mean_success_probability']:.2f}{reached}; "
+                      f"run blind {result['mean_open_loop_probability']:.2f}"
+                      + (f" (first plans that worked without replanning: {result['first_plan_worked']} of {result['found']})"
                          if "first_plan_worked" in result else ""))
     console.print(f"mean search: {result['mean_expanded']:.0f} nodes, {1000 * result['mean_seconds']:.0f} ms")
