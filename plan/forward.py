@@ -40,6 +40,13 @@ class Outcome:
     state: np.ndarray
 
 
+def _as_slice(index: np.ndarray):
+    """``index`` as a slice when it is a run of consecutive integers, else unchanged."""
+    if index.ndim == 1 and index.size and index.dtype.kind in "iu" and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
+
+
 class ForwardModel:
     """P(next state | state, behaviour, object, alpha) from learned predictors and prototypes.
 
@@ -59,7 +66,8 @@ class ForwardModel:
     def __init__(self, behaviors: list[BehaviorModel], min_probability: float = 0.02, param_steps: int = 5,
                  histograms: list[np.ndarray] | None = None):
         self.behaviors = behaviors
-        self.histograms = [np.asarray(h) for h in (histograms or [])]
+        # contiguous index runs become slices (much cheaper to index with, per node)
+        self.histograms = [_as_slice(np.asarray(h)) for h in (histograms or [])]
         self.names = [b.name for b in behaviors]
         self.min_probability = min_probability
         self.param_steps = param_steps
@@ -138,7 +146,7 @@ class ForwardModel:
         else:
             f[0] = 1.0
             for h in self.histograms:  # a predicted histogram is still a histogram
-                bins = np.clip(f[h], 0.0, None)
+                bins = np.maximum(f[h], 0.0)
                 total = bins.sum()
                 f[h] = bins / total if total > 0 else state[obj, h]
             nxt[obj] = f

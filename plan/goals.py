@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -66,23 +67,69 @@ class Constraint:
 class Goal:
     constraints: tuple[Constraint, ...]
 
-    def holds(self, state: np.ndarray) -> bool:
-        return all(c.holds(state) for c in self.constraints)
+    @cached_property
+    def _arrays(self) -> dict:
+        """The constraints as index arrays, for :meth:`gaps` (a search calls it per node)."""
+        kinds = {"one": [], "pair": [], "any": []}
+        for i, c in enumerate(self.constraints):
+            kinds["any" if c.obj == "*" else "pair" if isinstance(c.obj, tuple) else "one"].append(i)
 
-    def distance(self, state: np.ndarray) -> float:
+        def take(idx, f):
+            return np.array([f(self.constraints[i]) for i in idx])
+
+        one, pair, any_ = kinds["one"], kinds["pair"], kinds["any"]
+        return {
+            "one": (np.array(one, int), take(one, lambda c: c.obj).astype(int), take(one, lambda c: c.feature).astype(int)),
+            "pair": (np.array(pair, int), take(pair, lambda c: c.obj[0]).astype(int),
+                     take(pair, lambda c: c.obj[1]).astype(int), take(pair, lambda c: c.feature).astype(int)),
+            "any": (np.array(any_, int), take(any_, lambda c: c.feature).astype(int)),
+            "value": np.array([c.value for c in self.constraints], float),
+            "tolerance": np.array([c.tolerance for c in self.constraints], float),
+            "scale": np.array([SCALE.get(c.channel, 1.0) for c in self.constraints], float),
+            "named": [c.obj if isinstance(c.obj, int) else None for c in self.constraints],
+            "pairs": [c.obj if isinstance(c.obj, tuple) else None for c in self.constraints],
+        }
+
+    def gaps(self, state: np.ndarray) -> np.ndarray:
+        """How far each constraint is from holding (0 where it holds; for ``*``, the nearest object)."""
+        a = self._arrays
+        v = np.empty(len(self.constraints))
+        pos, obj, feat = a["one"]
+        v[pos] = state[obj, feat]
+        pos, i, j, feat = a["pair"]
+        v[pos] = state[i, feat] - state[j, feat]
+        gaps = np.maximum(np.abs(v - a["value"]) - a["tolerance"], 0.0)
+        pos, feat = a["any"]
+        if pos.size:
+            if state.shape[0] == 0:
+                gaps[pos] = np.inf
+            else:
+                cand = np.maximum(np.abs(state[:, feat] - a["value"][pos]) - a["tolerance"][pos], 0.0)
+                gaps[pos] = cand.min(axis=0)
+        return gaps
+
+    def holds(self, state: np.ndarray, gaps: np.ndarray | None = None) -> bool:
+        g = self.gaps(state) if gaps is None else gaps
+        return bool((g <= 1e-9).all())
+
+    def distance(self, state: np.ndarray, gaps: np.ndarray | None = None) -> float:
         """Scaled distance to the goal: 0 exactly when it holds (the search heuristic)."""
-        return float(sum(c.gaps(state).min() / SCALE.get(c.channel, 1.0) for c in self.constraints))
+        g = self.gaps(state) if gaps is None else gaps
+        return float((g / self._arrays["scale"]).sum())
 
-    def min_steps(self, state: np.ndarray) -> int:
+    def min_steps(self, state: np.ndarray, gaps: np.ndarray | None = None) -> int:
         """A lower bound on the steps still needed: a behaviour changes one object only.
 
         Every named object with an unmet constraint needs a step of its own, and so does an
         unmet relative constraint neither of whose objects is among them (``*`` constraints
         add nothing: a step on any object might meet them).
         """
-        named = {c.obj for c in self.constraints if isinstance(c.obj, int) and not c.holds(state)}
-        pairs = [c.obj for c in self.constraints if isinstance(c.obj, tuple) and not c.holds(state)]
-        return len(named) + int(any(a not in named and b not in named for a, b in pairs))
+        g = self.gaps(state) if gaps is None else gaps
+        unmet = g > 1e-9
+        a = self._arrays
+        named = {o for o, u in zip(a["named"], unmet) if u and o is not None}
+        pairs = [p for p, u in zip(a["pairs"], unmet) if u and p is not None]
+        return len(named) + int(any(i not in named and j not in named for i, j in pairs))
 
     @property
     def channels(self) -> set[str]:

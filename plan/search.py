@@ -130,14 +130,14 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
     if goal.holds(start):
         return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
     counter = 0
-    frontier = [(heuristic_weight * goal.distance(start), goal.distance(start), counter, 0.0, start, ())]
+    frontier = [(heuristic_weight * goal.distance(start), goal.distance(start), counter, 0.0, start, (), False)]
     best_cost: dict[bytes, float] = {_key(start): 0.0}
     expanded = generated = 0
     tree: list[dict] = []
     pending: list[np.ndarray] = []
     while frontier:
-        _, _, _, cost, state, steps = heapq.heappop(frontier)
-        if goal.holds(state):
+        _, _, _, cost, state, steps, done = heapq.heappop(frontier)
+        if done:
             plan = Plan(True, list(steps), math.exp(-cost), 0.0, expanded, generated, 0.0)
             plan.success_probability = success_probability(model, start, goal, plan.steps)
             plan.seconds = time.perf_counter() - t0
@@ -161,7 +161,8 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                 generated += 1
                 if _no_op(state, out.state, obj):
                     continue  # an outcome that changes nothing cannot be part of a shortest way
-                if len(steps) + 1 + goal.min_steps(out.state) > max_depth:
+                gaps = goal.gaps(out.state)
+                if len(steps) + 1 + goal.min_steps(out.state, gaps) > max_depth:
                     continue  # too many objects still to change in the steps left
                 c = cost - math.log(max(out.probability, 1e-12)) + penalty
                 k = _key(out.state)
@@ -169,11 +170,12 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                     continue
                 best_cost[k] = c
                 step = PlanStep(model.names[b], obj, alpha, out.category, out.probability, out.state)
-                h = goal.distance(out.state)
+                h = goal.distance(out.state, gaps)
                 if len(steps) < 1:
                     tree.append({"depth": 1, **step.to_json(), "distance": round(h, 3)})
                 counter += 1
-                heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,)))
+                heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,),
+                                          goal.holds(out.state, gaps)))
                 if len(steps) + 1 < max_depth:
                     pending.append(out.state[obj])
     return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
