@@ -179,4 +179,6 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02):
     names = model.schema.names
     histograms = [np.array([i for i, n in enumerate(names) if n.startswith(prefix + "_")])
                   for prefix in ("elevation", "azimuth")]
-    return ForwardModel(behaviors, min_probability=min_probability, histograms=[h for h in histograms if h.size])
+    height = names.index("z_min") if "z_min" in names else None
+    return ForwardModel(behaviors, min_probability=min_probability, histograms=[h for h in histograms if h.size],
+                        height=height)

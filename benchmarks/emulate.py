@@ -63,7 +63,7 @@ def main() -> None:
     from afford_cli.learning import forward_model, load_model
     from afford_cli.scenes_io import open_world
     from plan.emulate import goal_from_observation
-    from plan.monitor import execute
+    from plan.monitor import assess, execute
     from plan.search import search
     from sim.layout import load_layout
     from sim.registry import get_scene
@@ -85,11 +85,17 @@ def main() -> None:
             world = open_world(scene, specs, i + 1)
             fm = forward_model(model)
             goal = goal_from_observation(observed, world.perceive(), model.schema)
-            plan = search(fm, world.perceive(), goal, max_depth=4, max_nodes=20000)
+            start = world.perceive()
+            plan = assess(fm, start, goal, search(fm, start, goal, max_depth=4, max_nodes=20000), max_depth=4, max_nodes=20000)
             run = execute(world, fm, goal, first=plan, max_depth=4, max_nodes=20000) if plan.found else None
             runs.append({"found": plan.found, "reached": bool(run and run.reached), "replans": run.replans if run else 0,
-                         "reason": run.reason if run else plan.reason, "length": len(plan.steps)})
-        result["tasks"][task] = {"reached": sum(r["reached"] for r in runs), "layouts": len(runs), "runs": runs}
+                         "reason": run.reason if run else plan.reason, "length": len(plan.steps),
+                         "success_probability": round(plan.success_probability, 4),
+                         "open_loop_probability": round(plan.open_loop_probability or 0.0, 4)})
+        found = [r for r in runs if r["found"]]
+        result["tasks"][task] = {"reached": sum(r["reached"] for r in runs), "layouts": len(runs),
+                                 "mean_success_probability": round(float(np.mean([r["success_probability"] for r in found])), 4) if found else None,
+                                 "runs": runs}
     emit(result, args.out)
 
 

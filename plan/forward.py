@@ -57,6 +57,11 @@ class ForwardModel:
         Outcomes less likely than this are not expanded by the search.
     param_steps : int
         Grid points per parameter of a parametric behaviour (chapter 9).
+    height : int or None
+        Index of the object's bottom height (``z_min``): with it the planner knows when a
+        step leaves an object in the hand (:meth:`in_hand`).
+    raised : float
+        Rise (metres) that means an object is held.
     histograms : list of index arrays, optional
         Feature columns that form a normalised histogram (the shape channel's two): after
         adding a prototype they are clipped at 0 and renormalised, so that a predicted
@@ -64,8 +69,10 @@ class ForwardModel:
     """
 
     def __init__(self, behaviors: list[BehaviorModel], min_probability: float = 0.02, param_steps: int = 5,
-                 histograms: list[np.ndarray] | None = None):
+                 histograms: list[np.ndarray] | None = None, height: int | None = None, raised: float = 0.05):
         self.behaviors = behaviors
+        self.height = height
+        self.raised = raised
         # contiguous index runs become slices (much cheaper to index with, per node)
         self.histograms = [_as_slice(np.asarray(h)) for h in (histograms or [])]
         self.names = [b.name for b in behaviors]
@@ -136,6 +143,17 @@ class ForwardModel:
                 for v, p in zip(todo, proba):
                     self._cache[(b, v.tobytes(), alpha)] = (classes, p)
                 self.predictions += len(todo)
+
+    def in_hand(self, before: np.ndarray, after: np.ndarray, obj: int) -> bool:
+        """Did acting on ``obj`` leave it in the hand? It rose by more than ``raised``.
+
+        Only a grasp raises an object, and the hand keeps what it raised until its next
+        behaviour, which first opens it (sim.behaviors). A robot knows what its own hand
+        did; here it reads it off the object's bottom height, perceived or predicted.
+        """
+        if self.height is None or after[obj, 0] < 0.5:
+            return False
+        return bool(after[obj, self.height] - before[obj, self.height] > self.raised)
 
     def apply(self, state: np.ndarray, obj: int, b: int, category: int) -> np.ndarray:
         """The state after behaviour ``b`` on ``obj`` produced ``category``."""

@@ -61,18 +61,21 @@ def mismatch(goal: Goal, predicted: np.ndarray, perceived: np.ndarray, position_
 
 
 def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "best-first", max_replans: int = 3,
-            first: Plan | None = None, planner: Callable[[np.ndarray, tuple], Plan] | None = None,
+            first: Plan | None = None, planner: Callable[[np.ndarray, tuple, int], Plan] | None = None,
             **limits) -> Execution:
     """Plan (unless ``first`` is given), execute step by step, replan on surprises.
 
-    ``planner(state, avoid)`` replaces the search (with ``method`` and ``limits``) where given.
+    ``planner(state, avoid, held)`` replaces the search (with ``method`` and ``limits``)
+    where given. The robot keeps track of what its hand holds (an object a step raised) and
+    replans with it.
     """
     if planner is None:
-        def planner(state: np.ndarray, avoid: tuple) -> Plan:
-            return search(model, state, goal, method, avoid=avoid, **limits)
+        def planner(state: np.ndarray, avoid: tuple, held: int) -> Plan:
+            return search(model, state, goal, method, avoid=avoid, held=held, **limits)
 
     state = world.perceive()
-    plan = first if first is not None else planner(state, ())
+    held = -1
+    plan = first if first is not None else planner(state, (), held)
     run = Execution(False, [plan])
     failed: list[tuple[np.ndarray, str, int]] = []  # (object seen before, behaviour, object) that surprised
     while True:
@@ -85,8 +88,10 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             return run
         surprised = ""
         for step in plan.steps:
+            previous = state
             before = state[step.obj].copy()
             state = world.act(step.behavior, step.obj, np.asarray(step.alpha, dtype=float))
+            held = step.obj if model.in_hand(previous, state, step.obj) else -1
             surprised = mismatch(goal, step.predicted, state)
             if surprised:
                 failed.append((before, step.behavior, step.obj))
@@ -105,7 +110,7 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
         run.replans += 1
         # Behaviours that surprised the robot cost more in the new search: the model would
         # predict the same again, and the robot go round in circles.
-        plan = planner(state, tuple(failed))
+        plan = planner(state, tuple(failed), held)
         run.plans.append(plan)
 
 
@@ -169,10 +174,10 @@ def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: 
     rng = np.random.default_rng(seed)
     plans: dict = {}
 
-    def planner(state: np.ndarray, avoid: tuple) -> Plan:
-        key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o) for f, b, o in avoid))
+    def planner(state: np.ndarray, avoid: tuple, held: int) -> Plan:
+        key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o) for f, b, o in avoid), held)
         if key not in plans:
-            plans[key] = search(model, state, goal, method, avoid=avoid, **limits)
+            plans[key] = search(model, state, goal, method, avoid=avoid, held=held, **limits)
         return plans[key]
 
     reached = 0

@@ -68,9 +68,10 @@ class Plan:
                 "reason": self.reason}
 
 
-def _key(state: np.ndarray) -> bytes:
-    """States within a centimetre (and a hundredth of a histogram bin) of each other are one."""
-    return np.round(state, 2).tobytes()
+def _key(state: np.ndarray, held: int = -1) -> bytes:
+    """States within a centimetre (and a hundredth of a histogram bin) of each other, with
+    the same object in the hand, are one."""
+    return np.round(state, 2).tobytes() + held.to_bytes(2, "little", signed=True)
 
 
 #: Two situations of an object closer than this (metres, every position feature) are the same.
@@ -105,12 +106,18 @@ def _no_op(before: np.ndarray, after: np.ndarray, obj: int) -> bool:
     return bool(np.abs(after[obj, :7] - before[obj, :7]).max() < NO_OP)
 
 
-def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None):
+def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None, held: int = -1):
     """(behaviour, object, alpha) to try. A behaviour changes only its own object (chapter
-    8), so when the goal names its objects (no ``*``) acting on any other cannot help."""
+    8), so when the goal names its objects (no ``*``) acting on any other cannot help.
+
+    While the hand holds object ``held``, and the goal may be about it, only that object
+    is acted on: a behaviour on another one would first open the hand and drop it, an
+    effect on an object the behaviour is not about, which no predictor was trained to
+    foresee."""
     named = goal.objects() if goal is not None and all(c.obj != "*" for c in goal.constraints) else None
+    only = held if held >= 0 and (named is None or held in named) else None
     for obj in range(state.shape[0]):
-        if state[obj, 0] < 0.5 or (named is not None and obj not in named):
+        if state[obj, 0] < 0.5 or (named is not None and obj not in named) or (only is not None and obj != only):
             continue
         for b in range(len(model.behaviors)):
             for alpha in model.alphas(b):
@@ -118,8 +125,10 @@ def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None):
 
 
 def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4, max_nodes: int = 20000,
-               heuristic_weight: float = 0.0, avoid: tuple = ()) -> Plan:
+               heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1) -> Plan:
     """Most probable plan.
+
+    ``held``: the object in the hand at the start (-1: none); see :func:`_actions`.
 
     ``avoid`` lists steps that surprised the robot during execution (see :func:`_distrust`):
     they cost more, so the search tries something else first, yet a behaviour that is the
@@ -130,13 +139,13 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
     if goal.holds(start):
         return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
     counter = 0
-    frontier = [(heuristic_weight * goal.distance(start), goal.distance(start), counter, 0.0, start, (), False)]
-    best_cost: dict[bytes, float] = {_key(start): 0.0}
+    frontier = [(heuristic_weight * goal.distance(start), goal.distance(start), counter, 0.0, start, (), False, held)]
+    best_cost: dict[bytes, float] = {_key(start, held): 0.0}
     expanded = generated = 0
     tree: list[dict] = []
     pending: list[np.ndarray] = []
     while frontier:
-        _, _, _, cost, state, steps, done = heapq.heappop(frontier)
+        _, _, _, cost, state, steps, done, held = heapq.heappop(frontier)
         if done:
             plan = Plan(True, list(steps), math.exp(-cost), 0.0, expanded, generated, 0.0)
             plan.success_probability = success_probability(model, start, goal, plan.steps)
@@ -155,7 +164,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
         if any(not model.cached(state[i]) for i in range(state.shape[0]) if state[i, 0] >= 0.5):
             model.prefetch(pending + [state[i] for i in range(state.shape[0])])
             pending = []
-        for b, obj, alpha in _actions(model, state, goal):
+        for b, obj, alpha in _actions(model, state, goal, held):
             penalty = _distrust(avoid, state, model.names[b], obj) if avoid else 0.0
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
@@ -165,7 +174,8 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                 if len(steps) + 1 + goal.min_steps(out.state, gaps) > max_depth:
                     continue  # too many objects still to change in the steps left
                 c = cost - math.log(max(out.probability, 1e-12)) + penalty
-                k = _key(out.state)
+                now_held = obj if model.in_hand(state, out.state, obj) else -1
+                k = _key(out.state, now_held)
                 if best_cost.get(k, math.inf) <= c + 1e-12:
                     continue
                 best_cost[k] = c
@@ -175,7 +185,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                     tree.append({"depth": 1, **step.to_json(), "distance": round(h, 3)})
                 counter += 1
                 heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,),
-                                          goal.holds(out.state, gaps)))
+                                          goal.holds(out.state, gaps), now_held))
                 if len(steps) + 1 < max_depth:
                     pending.append(out.state[obj])
     return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
@@ -183,22 +193,22 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
 
 
 def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4,
-                  max_nodes: int = 20000, avoid: tuple = ()) -> Plan:
+                  max_nodes: int = 20000, avoid: tuple = (), held: int = -1) -> Plan:
     """Forward chaining over each behaviour's most probable outcome (thesis chapter 7)."""
     t0 = time.perf_counter()
     if goal.holds(start):
         return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
-    level = [(start, ())]
-    seen = {_key(start)}
+    level = [(start, (), held)]
+    seen = {_key(start, held)}
     expanded = generated = 0
     for _ in range(max_depth):
         nxt = []
-        for state, steps in level:
+        for state, steps, held in level:
             if expanded >= max_nodes:
                 return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
-            for b, obj, alpha in _actions(model, state, goal):
+            for b, obj, alpha in _actions(model, state, goal, held):
                 if avoid and _distrust(avoid, state, model.names[b], obj) >= 2 * DISTRUST:
                     continue  # chaining has no costs: a step that failed here is simply not retried
                 outs = model.outcomes(state, obj, b, alpha)
@@ -208,7 +218,8 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                 generated += 1
                 if _no_op(state, out.state, obj) or len(steps) + 1 + goal.min_steps(out.state) > max_depth:
                     continue
-                k = _key(out.state)
+                now_held = obj if model.in_hand(state, out.state, obj) else -1
+                k = _key(out.state, now_held)
                 if k in seen:
                     continue
                 seen.add(k)
@@ -218,7 +229,7 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                     plan.success_probability = success_probability(model, start, goal, plan.steps)
                     plan.seconds = time.perf_counter() - t0
                     return plan
-                nxt.append((out.state, new))
+                nxt.append((out.state, new, now_held))
         level = nxt
     return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                 f"no plan of at most {max_depth} steps reaches the goal")

@@ -168,6 +168,10 @@ def test_plan_and_execute_in_simulation(pipeline):
     assert out["goal"] == ["*:visibility=0~0.5"]
     assert out["plan"]["found"]
     assert 0 < out["plan"]["success_probability"] <= 1
+    # monitoring and replanning only add to the chance of the plan run blind (100 imagined
+    # rollouts: a standard error of at most 0.05)
+    assert out["plan"]["success_probability"] >= out["plan"]["open_loop_probability"] - 0.15
+    assert out["plan"]["replans_assumed"] == 3
     assert all({"behavior", "object", "alpha", "probability"} <= set(s) for s in out["plan"]["steps"])
     assert isinstance(out["reached"], bool) and out["replans"] >= 0
     if out["reached"]:  # then the object really is gone
@@ -181,6 +185,8 @@ def test_plan_episodes_report_rates(pipeline):
     assert out["found"] == sum(v["found"] for v in out["by_length"].values())
     assert out["reached"] == sum(v["reached"] for v in out["by_length"].values())
     assert 0 <= out["mean_success_probability"] <= 1
+    assert 0 <= out["mean_open_loop_probability"] <= 1
+    assert out["first_plan_worked"] <= out["reached"]
 
 
 def test_plan_refuses_bad_goals(pipeline):

@@ -255,3 +255,22 @@ def test_min_steps_bounds_the_steps_left_and_prunes_hopeless_branches():
     shallow = best_first(fm, scene(0.0, 0.5, 1.0), three, max_depth=2)
     assert not shallow.found and shallow.expanded == 1  # no child can finish in time
     assert best_first(fm, scene(0.0, 0.5, 1.0), three, max_depth=3).found
+
+
+def test_while_the_hand_holds_an_object_only_that_object_is_acted_on():
+    z = SCHEMA.index("z_min")
+    up = np.zeros(D)
+    up[z] = 0.3
+    lift = behaviour("lift", [(0.9, up), (0.1, effect())])
+    both_up = goal("0:z_min=0.3~0.01", "1:z_min=0.3~0.01")
+    # one hand cannot hold two objects up: lifting the second would drop the first
+    assert not best_first(ForwardModel([lift], height=z), scene(0.0, 0.5), both_up).found
+    assert best_first(ForwardModel([lift]), scene(0.0, 0.5), both_up).found  # a model that cannot tell
+    # lift one, then push it along: the object in the hand may still be acted on
+    fm = ForwardModel([lift, NUDGE], height=z)
+    plan = best_first(fm, scene(0.0, 0.5), goal("0:z_min=0.3~0.01", "0:x_min=0.1~0.01"))
+    assert plan.found and [s.obj for s in plan.steps] == [0, 0]
+    # a replan that starts with object 1 in the hand lets go of it only where the goal
+    # does not care about object 1
+    assert not best_first(fm, scene(0.0, 0.5), goal("0:x_min=0.1~0.01", "1:x_min=0.5~0.01"), held=1).found
+    assert best_first(fm, scene(0.0, 0.5), goal("0:x_min=0.1~0.01"), held=1).found
