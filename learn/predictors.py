@@ -69,8 +69,9 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
     """Calibrated SVM predicting a behaviour's effect category from object features.
 
     ``Pipeline(StandardScaler, OneVsRestClassifier(SVC))`` with C (and gamma) chosen by a
-    stratified, cross-validated grid search on accuracy (the smoothest setting within one
-    standard error of the best), then ``CalibratedClassifierCV`` on the same folds. By
+    stratified, cross-validated grid search on accuracy (by default the smoothest setting
+    within one standard error of the best), then ``CalibratedClassifierCV`` on the same
+    folds. By
     default the calibrator is fitted on the out-of-fold margins and one SVM is refitted on
     all rows (``ensemble=False``): averaging the probabilities of the fold models instead
     made them under-confident (mean confidence 0.75 at 0.85 accuracy on the table scene).
@@ -90,6 +91,12 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         RBF widths to try. None: ``(0.1, 1, 10) / n_features``. Ignored for ``"linear"``.
     cv : int, default=3
         Folds of the grid search and of the calibration.
+    choice : {"one-se", "best"}, default="one-se"
+        Which grid setting: the smoothest (smallest gamma, then C) within one standard
+        error of the most accurate, or the most accurate. On a planted noisy problem the
+        smooth one's probabilities are closer to the truth (a test); on the table scene's
+        5000 interactions the two mostly coincide, and where they did not (out of fold),
+        "best" gained 0.1-0.7 points of accuracy and 0.006-0.018 of ECE.
     calibration : {"sigmoid", "isotonic", "temperature"}, default="temperature"
         Temperature scaling fits one softmax temperature over the per-category margins;
         on the table scene it gave the lowest calibration error (0.03-0.06 against
@@ -132,19 +139,21 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         "C_grid": ["array-like"],
         "gamma_grid": ["array-like", None],
         "cv": [Interval(numbers.Integral, 2, None, closed="left")],
+        "choice": [StrOptions({"one-se", "best"})],
         "calibration": [StrOptions({"sigmoid", "isotonic", "temperature"})],
         "ensemble": ["boolean"],
         "n_jobs": [numbers.Integral, None],
         "random_state": ["random_state"],
     }
 
-    def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0, 1000.0), gamma_grid=None, cv=3,
+    def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0, 1000.0), gamma_grid=None, cv=3, choice="one-se",
                  calibration="temperature", ensemble=False, n_jobs=None, random_state=None):
         self.ensemble = ensemble
         self.kernel = kernel
         self.C_grid = C_grid
         self.gamma_grid = gamma_grid
         self.cv = cv
+        self.choice = choice
         self.calibration = calibration
         self.n_jobs = n_jobs
         self.random_state = random_state
@@ -231,7 +240,10 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
                               error_score="raise")
         search.fit(X, y_idx)
         params = search.cv_results_["params"]
-        best = self._simplest_good(search.cv_results_)
+        if self.choice == "one-se":
+            best = self._simplest_good(search.cv_results_)
+        else:
+            best = int(np.argmax(search.cv_results_["mean_test_score"]))
         model = clone(base).set_params(**params[best])
         cal_rows = np.arange(y_idx.size)
         cal_folds = folds

@@ -421,3 +421,12 @@ def test_fast_probabilities_equal_predict_proba(kernel):
     assert np.allclose(fast(Xt), model.predict_proba(Xt), atol=1e-9)
     binary = AffordancePredictor(calibration="sigmoid", random_state=0).fit(X, (X[:, 2] > 0).astype(int))
     assert np.allclose(fast_predict_proba(binary)(Xt), binary.predict_proba(Xt), atol=1e-9)
+
+
+def test_grid_choice_best_or_smoothest_within_one_standard_error():
+    x, y, _ = noisy_logistic(600, 3)
+    best = AffordancePredictor(choice="best", random_state=0).fit(x, y).cv_report_
+    smooth = AffordancePredictor(choice="one-se", random_state=0).fit(x, y).cv_report_
+    assert best["cv_accuracy"] == max(g["accuracy"] for g in best["grid"])
+    assert smooth["cv_accuracy"] >= best["cv_accuracy"] - best["cv_accuracy_std"]
+    assert (smooth["best_params"]["gamma"], smooth["best_params"]["C"]) <= (best["best_params"]["gamma"], best["best_params"]["C"])
