@@ -109,7 +109,7 @@ _MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created"
 
 def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict, selected: dict,
                   predictors: dict, settings: dict, known: dict | None = None) -> tuple[dict, dict, dict]:
-    from learn.affordances import behaviour_rows, n_params, predictor_inputs
+    from learn.affordances import behaviour_rows, known_columns, n_params, predictor_inputs
 
     arrays, blobs, cv, categories = {}, {}, {}, {}
     for b, name in enumerate(data.behavior_names):
@@ -123,6 +123,7 @@ def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects
         blobs[_blob_name("predictor", name)] = dump_estimator(model)
         if known and known.get(name) is not None:
             blobs[_blob_name("known", name)] = dump_estimator(known[name])
+            arrays[f"known_selected.{name}"] = known_columns(data.schema).astype(np.int16)
         cv[name] = model.cv_report_
         categories[name] = category_report(data, labels, b, ec.prototypes_)
     meta = {
@@ -153,6 +154,9 @@ class LoadedModel:
         self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED) for n in self.names}
         self.known = {n: art.estimator(_blob_name("known", n), TRUSTED) if _blob_name("known", n) in art.blobs else None
                       for n in self.names}
+        # the features P(known) reads (models from before they had their own: the selected)
+        self.known_selected = {n: art.arrays[f"known_selected.{n}"].astype(int) if f"known_selected.{n}" in art.arrays
+                               else self.selected[n] for n in self.names}
 
     def n_params(self, name: str) -> int:
         return len(self.behaviors[self.names.index(name)].get("parameters", []))
@@ -175,7 +179,7 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02):
     for b, name in enumerate(model.names):
         params = [(float(p["low"]), float(p["high"])) for p in model.behaviors[b].get("parameters", [])]
         behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params,
-                                       known=model.known[name]))
+                                       known=model.known[name], known_selected=model.known_selected[name]))
     names = model.schema.names
     histograms = [np.array([i for i, n in enumerate(names) if n.startswith(prefix + "_")])
                   for prefix in ("elevation", "azimuth")]

@@ -31,6 +31,7 @@ class BehaviorModel:
     prototypes: np.ndarray             # (n_categories, d) mean effects
     parameters: list[tuple[float, float]] = field(default_factory=list)  # alpha ranges
     known: object | None = None        # P(the effect is of a kept kind): predict_proba, classes_ [0, 1]
+    known_selected: np.ndarray | None = None  # the columns ``known`` reads (None: ``selected``)
 
 
 @dataclass(frozen=True)
@@ -137,7 +138,9 @@ class ForwardModel:
                 proba = self._proba(model.predictor)(X)
                 if model.known is not None:
                     # the chance that the effect is one of the kinds the categories kept
-                    kept = self._proba(model.known)(X)[:, list(model.known.classes_).index(1)]
+                    Xk = X if model.known_selected is None else np.stack(
+                        [np.concatenate([v[model.known_selected], np.asarray(alpha, dtype=float)]) for v in todo])
+                    kept = self._proba(model.known)(Xk)[:, list(model.known.classes_).index(1)]
                     proba = proba * kept[:, None]
                 classes = np.asarray(model.predictor.classes_, dtype=int)
                 for v, p in zip(todo, proba):

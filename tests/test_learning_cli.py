@@ -64,6 +64,15 @@ def test_model_reports_features_and_predicts(pipeline):
     assert len(info["features"]) == 43 and info["kind"] == "model"
     assert set(info["behaviors"]) == {"push-forward", "push-left", "push-right", "lift"}
     assert all(len(b["selected"]) == 12 for b in info["behaviors"].values())
+    from afford_cli.learning import forward_model, load_model
+
+    loaded = load_model(str(pipeline / "model.afford"))
+    fm = forward_model(loaded)
+    assert any(bm.known is not None for bm in fm.behaviors)
+    for name, bm in zip(loaded.names, fm.behaviors):
+        if bm.known is not None:  # P(known) reads every feature, the category predictor its 12
+            assert np.array_equal(bm.known_selected, np.arange(43)) and bm.known.n_features_in_ == 43
+            assert bm.predictor.n_features_in_ == 12
     result = json.loads(ok(["evaluate", str(pipeline / "model.afford"), str(pipeline / "test.afford"),
                             "--baselines", "--json"]).stdout)
     for name, m in result["behaviors"].items():

@@ -38,7 +38,7 @@ def train(
     start = time.perf_counter()
     with out.progress(f"training predictors ({kernel.value} SVM)", len(data.behaviors)) as update:
         predictors = train_predictors(data, labels, selected, kernel=kernel.value, seed=seed, progress=update)
-    known = train_known(data, labels, selected, seed=seed)
+    known = train_known(data, labels, seed=seed)
     settings = {"kernel": kernel.value, "selection": art.kind}
     arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known)
     write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
