@@ -1,6 +1,6 @@
 """Emulation success over varied start layouts (thesis 8.7's three tasks).
 
-    python benchmarks/emulate.py [--model PATH | --interactions 5000] [--layouts 10] [--seed 42]
+    python benchmarks/emulate.py [--model PATH | --interactions 5000] [--layouts 10] [--seed 42] [--max-depth 5] [--tasks clear,lift,close]
 
 For each task the shown scene is the example layout in examples/layouts, and the start
 scenes are drawn at random (objects small enough to lift, within reach): clear the table
@@ -57,6 +57,8 @@ def main() -> None:
     ap.add_argument("--interactions", type=int, default=5000)
     ap.add_argument("--layouts", type=int, default=10)
     ap.add_argument("--seed", type=int, default=42)
+    ap.add_argument("--max-depth", type=int, default=5)
+    ap.add_argument("--tasks", default="clear,lift,close")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "emulate.json"))
     args = ap.parse_args()
 
@@ -75,7 +77,9 @@ def main() -> None:
     model = load_model(args.model)
     scene = get_scene("table")()
     result = {"benchmark": "emulate", "tasks": {}}
-    for task in ("clear", "lift", "close"):
+    limits = {"max_depth": args.max_depth, "max_nodes": 20000}
+    result["max_depth"] = args.max_depth
+    for task in args.tasks.split(","):
         rng = np.random.default_rng(args.seed)
         runs = []
         for i in range(args.layouts):
@@ -86,8 +90,8 @@ def main() -> None:
             fm = forward_model(model)
             goal = goal_from_observation(observed, world.perceive(), model.schema)
             start = world.perceive()
-            plan = assess(fm, start, goal, search(fm, start, goal, max_depth=4, max_nodes=20000), max_depth=4, max_nodes=20000)
-            run = execute(world, fm, goal, first=plan, max_depth=4, max_nodes=20000) if plan.found else None
+            plan = assess(fm, start, goal, search(fm, start, goal, **limits), **limits)
+            run = execute(world, fm, goal, first=plan, **limits) if plan.found else None
             runs.append({"found": plan.found, "reached": bool(run and run.reached), "replans": run.replans if run else 0,
                          "reason": run.reason if run else plan.reason, "length": len(plan.steps),
                          "success_probability": round(plan.success_probability, 4),

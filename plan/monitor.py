@@ -147,8 +147,8 @@ class _Imagined:
 
 
 def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int = 3,
-                      method: str = "best-first", rollouts: int = 100, seed: int = 0, imagined_nodes: int = 2000,
-                      **limits) -> float:
+                      method: str = "best-first", rollouts: int = 100, seed: int = 0, imagined_nodes: int = 1000,
+                      budget: int = 4000, **limits) -> float:
     """P(reaching the goal by running ``plan`` the way :func:`execute` does), by the model.
 
     The open-loop probability (:func:`plan.search.success_probability`) answers for the
@@ -164,31 +164,46 @@ def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: 
 
     Imagined replans search with at most ``imagined_nodes`` expansions (a search that finds
     nothing spends its whole budget, and imagined rollouts meet many hopeless states); a
-    replan that would need more counts as failed, so the figure errs low there.
+    replan that would need more counts as failed, so the figure errs low there. Once the
+    imagined searches have expanded ``budget`` nodes in all, no new rollout starts (but at
+    least 20 run): the figure then rests on fewer rollouts, which bounds its cost.
     """
+    return _reach(model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts, seed=seed,
+                  imagined_nodes=imagined_nodes, budget=budget, **limits)[0]
+
+
+def _reach(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int, method: str,
+           rollouts: int, seed: int, imagined_nodes: int, budget: int, **limits) -> tuple[float, int]:
+    """:func:`reach_probability` and the number of rollouts it ran."""
     limits = {**limits, "max_nodes": min(limits.get("max_nodes", imagined_nodes), imagined_nodes)}
     if goal.holds(start):
-        return 1.0
+        return 1.0, 0
     if not plan.found:
-        return 0.0
+        return 0.0, 0
     rng = np.random.default_rng(seed)
     plans: dict = {}
+    spent = 0
 
     def planner(state: np.ndarray, avoid: tuple, held: int) -> Plan:
+        nonlocal spent
         key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o) for f, b, o in avoid), held)
         if key not in plans:
             plans[key] = search(model, state, goal, method, avoid=avoid, held=held, **limits)
+            spent += plans[key].expanded
         return plans[key]
 
-    reached = 0
-    for _ in range(rollouts):
+    reached = done = 0
+    while done < rollouts and (spent < budget or done < min(20, rollouts)):
         world = _Imagined(model, start, rng)
         reached += execute(world, model, goal, method=method, max_replans=max_replans, first=plan,
                            planner=planner).reached
-    return reached / rollouts
+        done += 1
+    return reached / done, done
+
 
 def assess(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int = 3,
-           method: str = "best-first", rollouts: int = 100, seed: int = 0, **limits) -> Plan:
+           method: str = "best-first", rollouts: int = 100, seed: int = 0, imagined_nodes: int = 1000,
+           budget: int = 4000, **limits) -> Plan:
     """Make ``plan.success_probability`` the chance of reaching the goal with monitoring
     (:func:`reach_probability`).
 
@@ -198,7 +213,8 @@ def assess(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, ma
     if plan.open_loop_probability is None:
         plan.open_loop_probability = plan.success_probability
     if plan.found:
-        plan.success_probability = reach_probability(model, start, goal, plan, max_replans=max_replans,
-                                                     method=method, rollouts=rollouts, seed=seed, **limits)
+        plan.success_probability, plan.rollouts = _reach(
+            model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts, seed=seed,
+            imagined_nodes=imagined_nodes, budget=budget, **limits)
     plan.replans_assumed = max_replans
     return plan

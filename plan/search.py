@@ -57,6 +57,7 @@ class Plan:
     tree: list[dict] = field(default_factory=list)  # the first levels of the search, for reports
     open_loop_probability: float | None = None  # set with success_probability by the search
     replans_assumed: int = 0  # success_probability assumes monitoring with this many replans
+    rollouts: int = 0  # imagined executions behind success_probability (0: open-loop figure)
 
     def to_json(self) -> dict:
         open_loop = self.success_probability if self.open_loop_probability is None else self.open_loop_probability
@@ -64,6 +65,7 @@ class Plan:
                 "path_probability": round(self.path_probability, 4),
                 "success_probability": round(self.success_probability, 4),
                 "open_loop_probability": round(open_loop, 4), "replans_assumed": self.replans_assumed,
+                "rollouts": self.rollouts,
                 "expanded": self.expanded, "generated": self.generated, "seconds": round(self.seconds, 4),
                 "reason": self.reason}
 

@@ -274,3 +274,14 @@ def test_while_the_hand_holds_an_object_only_that_object_is_acted_on():
     # does not care about object 1
     assert not best_first(fm, scene(0.0, 0.5), goal("0:x_min=0.1~0.01", "1:x_min=0.5~0.01"), held=1).found
     assert best_first(fm, scene(0.0, 0.5), goal("0:x_min=0.1~0.01"), held=1).found
+
+
+def test_reach_probability_stops_starting_rollouts_when_its_search_budget_is_spent():
+    fm = ForwardModel([PUSH_HALF, SLIDE])
+    g = goal("0:x_min=0.4~0.01")
+    plan = best_first(fm, scene(0.0), g)
+    full = reach_probability(fm, scene(0.0), g, plan, rollouts=1000, seed=2)
+    capped = reach_probability(fm, scene(0.0), g, plan, rollouts=1000, seed=2, budget=0)
+    assert abs(capped - full) < 0.35
+    assert assess(fm, scene(0.0), g, plan, rollouts=1000, seed=2).rollouts == 1000
+    assert assess(fm, scene(0.0), g, plan, rollouts=1000, seed=2, budget=0).rollouts == 20

@@ -21,7 +21,7 @@ def emulate(
     start: Annotated[str, typer.Option("--start", help="Layout of the scene the robot starts from.")],
     scene: SceneName = "table",
     execute: Annotated[bool, typer.Option("--execute/--no-execute", help="Run the plan in the simulator with monitoring.")] = True,
-    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8)] = 4,
+    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")] = 5,
     max_nodes: Annotated[int, typer.Option("--max-nodes", min=1)] = 20000,
     max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
     seed: Annotated[int, typer.Option("--seed", "-s", min=0, help="Seed of the simulated worlds (noise).")] = 0,

@@ -90,7 +90,7 @@ def plan(
     seed: Annotated[Optional[int], typer.Option("--seed", "-s", min=0, help="Draw a random scene from this seed.")] = None,
     objects: Annotated[int, typer.Option("--objects", min=1, max=6, help="Objects in a drawn scene.")] = 1,
     layout: Annotated[Optional[str], typer.Option("--layout", help="A TOML layout file that pins the scene.")] = None,
-    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")] = 4,
+    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")] = 5,
     max_nodes: Annotated[int, typer.Option("--max-nodes", min=1, help="Most search nodes to expand.")] = 20000,
     method: Annotated[SearchMethod, typer.Option("--search", help="Most probable plan (best-first) or the thesis's breadth-first chaining.")] = SearchMethod.best_first,
     execute: Annotated[bool, typer.Option("--execute", help="Run the plan in the simulator, monitor it and replan on surprises.")] = False,
