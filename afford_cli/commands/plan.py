@@ -60,10 +60,11 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
     if not p["found"]:
         console.print(f"[red]no plan[/]: {p['reason']} ({p['expanded']} nodes expanded, {p['seconds']:.2f} s)")
         return
-    table = Table(title=f"plan: {p['length']} steps, success probability {p['success_probability']:.2f} "
-                        f"with monitoring and up to {p['replans_assumed']} replans, "
-                        f"{p['open_loop_probability']:.2f} run blind "
-                        f"({p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms)", box=box.SIMPLE_HEAD)
+    console.print(f"plan: {p['length']} step{'s' if p['length'] != 1 else ''} "
+                  f"({p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms); success probability "
+                  f"{p['success_probability']:.2f} with monitoring and up to {p['replans_assumed']} replans, "
+                  f"{p['open_loop_probability']:.2f} run blind")
+    table = Table(box=box.SIMPLE_HEAD)
     for col in ("step", "behaviour", "object", "alpha", "expected category", "p"):
         table.add_column(col)
     for i, s in enumerate(p["steps"], 1):
