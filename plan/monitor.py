@@ -6,7 +6,12 @@ keeps track of which perceived object is which, so a step's prediction is compar
 the perception of the same objects. When a perceived outcome differs from the predicted one
 on the goal's channels, the robot replans from what it perceives, up to ``max_replans`` times,
 and a behaviour that already surprised it on an object costs more in the new search (the same
-prediction would otherwise send it round in circles).
+prediction would otherwise send it round in circles). The robot knows which object its hand
+holds (one a step raised) and replans with it.
+
+:func:`reach_probability` runs the same executor in worlds drawn from the model, to tell how
+likely a plan is to reach its goal when it is run this way; :func:`assess` stores that on
+the plan next to its open-loop probability.
 """
 
 from __future__ import annotations
