@@ -4,7 +4,8 @@ The planner talks to the world through the small :class:`World` protocol, which 
 simulator implements (``sim.session.SimWorld``); ``plan`` never imports ``sim``. The world
 keeps track of which perceived object is which, so a step's prediction is compared with
 the perception of the same objects. When a perceived outcome differs from the predicted one
-on the goal's channels, the robot replans from what it perceives, up to ``max_replans`` times,
+on the goal's channels, the robot replans from what it perceives, up to ``max_replans`` times
+(and up to as many more after surprises that left the world nearer the goal than predicted),
 and a behaviour that already surprised it on an object costs more in the new search (the same
 prediction would otherwise send it round in circles). The robot knows which object its hand
 holds (one a step raised) and replans with it.
@@ -41,9 +42,10 @@ class Execution:
     executed: list[dict] = field(default_factory=list)  # every step run, with what was perceived
     replans: int = 0
     reason: str = ""
+    windfalls: int = 0  # replans after a surprise that left the world nearer the goal than predicted
 
     def to_json(self) -> dict:
-        return {"reached": self.reached, "replans": self.replans, "reason": self.reason,
+        return {"reached": self.reached, "replans": self.replans, "windfalls": self.windfalls, "reason": self.reason,
                 "executed": self.executed, "plans": [p.to_json() for p in self.plans]}
 
 
@@ -91,7 +93,7 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             run.reached = True
             run.reason = "goal reached"
             return run
-        surprised = ""
+        surprised, windfall = "", False
         for step in plan.steps:
             previous = state
             before = state[step.obj].copy()
@@ -106,13 +108,19 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
                 run.reason = "goal reached"
                 return run
             if surprised:
+                windfall = goal.distance(state) < goal.distance(step.predicted) - 1e-9
                 break
         if not surprised:  # every step went as predicted, yet the goal does not hold
             surprised = "the plan ran as predicted but the goal does not hold"
-        if run.replans >= max_replans:
+        if windfall and run.windfalls < max_replans:
+            # The world went the goal's way further than predicted (another object fell
+            # too): a new plan is needed, but the model did not let the robot down.
+            run.windfalls += 1
+        elif run.replans >= max_replans:
             run.reason = f"gave up after {run.replans} replans ({surprised})"
             return run
-        run.replans += 1
+        else:
+            run.replans += 1
         # Behaviours that surprised the robot cost more in the new search: the model would
         # predict the same again, and the robot go round in circles.
         plan = planner(state, tuple(failed), held)

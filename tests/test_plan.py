@@ -285,3 +285,23 @@ def test_reach_probability_stops_starting_rollouts_when_its_search_budget_is_spe
     assert abs(capped - full) < 0.35
     assert assess(fm, scene(0.0), g, plan, rollouts=1000, seed=2).rollouts == 1000
     assert assess(fm, scene(0.0), g, plan, rollouts=1000, seed=2, budget=0).rollouts == 20
+
+
+def test_a_surprise_that_helps_does_not_use_up_the_replans():
+    # the first sweep sends object 0 off and knocks object 1 off too; later sweeps miss
+    world = ScriptedWorld(scene(0.0, 0.5, 1.0), {"sweep": [effect()]})
+    real_act = world.act
+
+    def act(behavior, target, alpha=None):
+        if not world.calls:
+            world.calls.append((behavior, target))
+            world.state[target, 0] = 0.0
+            world.state[1 if target != 1 else 0, 0] = 0.0
+            return world.perceive()
+        return real_act(behavior, target, alpha)
+
+    world.act = act
+    fm = ForwardModel([SWEEP])
+    run = execute(world, fm, goal("0:visibility=0", "1:visibility=0", "2:visibility=0"), max_replans=1)
+    assert run.windfalls == 1 and run.replans == 1 and len(world.calls) == 3
+    assert "gave up after 1 replans" in run.reason  # a miss, by contrast, uses the budget up

@@ -50,7 +50,7 @@ def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dic
         out["reached"] = result.reached
         out["replans"] = result.replans
         # did the first plan, as planned, work without replanning?
-        out["first_plan_worked"] = result.reached and result.replans == 0
+        out["first_plan_worked"] = result.reached and result.replans == 0 and result.windfalls == 0
     return out
 
 
@@ -81,7 +81,8 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
             mark = "[green]as predicted[/]" if s["as_predicted"] else f"[yellow]{s['note']}[/]"
             console.print(f"  ran {s['behavior']} on {s['object']}: {mark}")
         verdict = "[green]goal reached[/]" if ex["reached"] else f"[red]not reached[/]: {ex['reason']}"
-        console.print(f"{verdict} (replans: {ex['replans']})")
+        extra = f", and {ex['windfalls']} after surprises that helped" if ex.get("windfalls") else ""
+        console.print(f"{verdict} (replans: {ex['replans']}{extra})")
 
 
 def plan(
