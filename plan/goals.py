@@ -42,22 +42,6 @@ class Constraint:
     tolerance: float
     channel: str
 
-    def values(self, state: np.ndarray) -> np.ndarray:
-        """The constrained quantity for every object this constraint may be about."""
-        if self.obj == "*":
-            return state[:, self.feature]
-        if isinstance(self.obj, tuple):
-            a, b = self.obj
-            return np.array([state[a, self.feature] - state[b, self.feature]])
-        return np.array([state[self.obj, self.feature]])
-
-    def gaps(self, state: np.ndarray) -> np.ndarray:
-        """How far outside the tolerance each candidate lies (0 where it holds)."""
-        return np.maximum(np.abs(self.values(state) - self.value) - self.tolerance, 0.0)
-
-    def holds(self, state: np.ndarray) -> bool:
-        return bool((self.gaps(state) <= 1e-9).any())
-
     def text(self) -> str:
         obj = f"{self.obj[0]}-{self.obj[1]}" if isinstance(self.obj, tuple) else str(self.obj)
         return f"{obj}:{self.name}={self.value:g}~{self.tolerance:g}"
