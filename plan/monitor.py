@@ -84,7 +84,8 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
     held = -1
     plan = first if first is not None else planner(state, (), held)
     run = Execution(False, [plan])
-    failed: list[tuple[np.ndarray, str, int]] = []  # (object seen before, behaviour, object) that surprised
+    # (object seen before, behaviour, object, whether the hand held it) of steps that surprised
+    failed: list[tuple[np.ndarray, str, int, bool]] = []
     while True:
         if not plan.found:
             run.reason = f"no plan found ({plan.reason})"
@@ -95,13 +96,13 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             return run
         surprised, windfall = "", False
         for step in plan.steps:
-            previous = state
+            previous, was_held = state, held == step.obj
             before = state[step.obj].copy()
             state = world.act(step.behavior, step.obj, np.asarray(step.alpha, dtype=float))
             held = step.obj if model.in_hand(previous, state, step.obj) else -1
             surprised = mismatch(goal, step.predicted, state)
             if surprised:
-                failed.append((before, step.behavior, step.obj))
+                failed.append((before, step.behavior, step.obj, was_held))
             run.executed.append({**step.to_json(), "as_predicted": not surprised, "note": surprised})
             if goal.holds(state):
                 run.reached = True
@@ -199,7 +200,7 @@ def _reach(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, ma
 
     def planner(state: np.ndarray, avoid: tuple, held: int) -> Plan:
         nonlocal spent
-        key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o) for f, b, o in avoid), held)
+        key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o, h) for f, b, o, h in avoid), held)
         if key not in plans:
             plans[key] = search(model, state, goal, method, avoid=avoid, held=held, **limits)
             spent += plans[key].expanded

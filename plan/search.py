@@ -83,19 +83,28 @@ SAME_PLACE = 0.05
 DISTRUST = math.log(2.0)
 
 
-def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int) -> float:
+def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int, held: int = -1) -> float:
     """Extra search cost of ``behavior`` on ``obj`` after it surprised the robot.
 
-    ``avoid`` holds (object features before, behaviour, object) of steps whose outcome
-    surprised the robot during execution. Each such surprise costs 2 * DISTRUST where the
-    object is in the same situation again (within SAME_PLACE) and DISTRUST elsewhere: the
-    model erred there, and would predict the same again.
+    ``avoid`` holds (object features before, behaviour, object, whether the hand held it)
+    of steps whose outcome surprised the robot during execution. Each such surprise costs
+    2 * DISTRUST where the object is in the same situation again (within SAME_PLACE) and
+    DISTRUST elsewhere: the model erred there, and would predict the same again.
+
+    A surprise on an object the hand held also costs DISTRUST for every other behaviour on
+    that object while it is held again. Every behaviour starts by opening the hand, so what
+    follows begins with the same drop, and the model saw the held object with the hand
+    hiding its shape: whatever misled it about one behaviour misleads it about the others.
     """
     f = state[obj, 1:7]
     cost = 0.0
-    for g, b, i in avoid:
-        if b == behavior and i == obj:
+    for g, b, i, in_hand in avoid:
+        if i != obj:
+            continue
+        if b == behavior:
             cost += 2 * DISTRUST if np.abs(f - g[1:7]).max() < SAME_PLACE else DISTRUST
+        elif in_hand and held == obj:
+            cost += DISTRUST
     return cost
 
 
@@ -167,7 +176,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
             model.prefetch(pending + [state[i] for i in range(state.shape[0])])
             pending = []
         for b, obj, alpha in _actions(model, state, goal, held):
-            penalty = _distrust(avoid, state, model.names[b], obj) if avoid else 0.0
+            penalty = _distrust(avoid, state, model.names[b], obj, held) if avoid else 0.0
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
                 if _no_op(state, out.state, obj):
@@ -211,7 +220,7 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
             for b, obj, alpha in _actions(model, state, goal, held):
-                if avoid and _distrust(avoid, state, model.names[b], obj) >= 2 * DISTRUST:
+                if avoid and _distrust(avoid, state, model.names[b], obj, held) >= 2 * DISTRUST:
                     continue  # chaining has no costs: a step that failed here is simply not retried
                 outs = model.outcomes(state, obj, b, alpha)
                 if not outs:
