@@ -4,6 +4,8 @@ Layout (DESIGN.md section 3)::
 
     manifest.json   format, kind, schema_version, afford_version, created, command, seed,
                     parents [{kind, sha256}], members {name: sha256}, and report data
+    manifest.sha256 the sha256 of manifest.json's bytes (schema 2 on): an edited manifest,
+                    not only an edited member, is caught
     <name>.npy      arrays, always read with allow_pickle=False
     <name>.skops    fitted estimators (skops.io), loaded with an explicit trusted-type list
 
@@ -38,10 +40,12 @@ __all__ = [
 
 FORMAT = "afford"
 #: Bump when the layout changes; teach ``_migrate`` the step from the previous one.
-SCHEMA_VERSION = 1
+#: 2: the manifest's own checksum (``manifest.sha256``).
+SCHEMA_VERSION = 2
 MIN_SCHEMA_VERSION = 1
 KINDS = ("interactions", "effects", "features", "model")
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+_SEAL = "manifest.sha256"
 
 #: Types an estimator member may contain; anything else is refused on load.
 TRUSTED_TYPES: list[str] = []
@@ -140,9 +144,10 @@ def artifact_bytes(kind: str, arrays: dict[str, np.ndarray], meta: dict[str, Any
         "members": {name: _sha256(data) for name, data in members.items()},
         **meta,
     }
+    text = json.dumps(manifest, indent=1, sort_keys=True).encode()
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        for name, data in [("manifest.json", json.dumps(manifest, indent=1, sort_keys=True).encode())] + list(members.items()):
+        for name, data in [("manifest.json", text), (_SEAL, _sha256(text).encode())] + list(members.items()):
             info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
             info.compress_type = zipfile.ZIP_DEFLATED
             info.external_attr = 0o644 << 16
@@ -214,7 +219,8 @@ def _read_source(path: str) -> bytes:
 
 
 def _migrate(manifest: dict) -> dict:
-    """Bring an older manifest up to SCHEMA_VERSION (nothing to do yet: there is only v1)."""
+    """Bring an older manifest up to SCHEMA_VERSION. 1 -> 2 added only the manifest's own
+    checksum member, which :func:`read_artifact` asks of schema 2 files alone."""
     return manifest
 
 
@@ -226,7 +232,8 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
         raise AffordError(f"{name} is empty, not an afford file")
     try:
         zf = zipfile.ZipFile(io.BytesIO(raw))
-        manifest = json.loads(zf.read("manifest.json"))
+        text = zf.read("manifest.json")
+        manifest = json.loads(text)
     except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError):
         raise AffordError(f"{name} is not an afford file") from None
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
@@ -243,6 +250,13 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
     if version < MIN_SCHEMA_VERSION:
         raise AffordError(f"{name} uses artefact schema {version}, which this afford can no longer read "
                           f"(oldest supported: {MIN_SCHEMA_VERSION}); re-create it")
+    if version >= 2:
+        try:
+            seal = zf.read(_SEAL).decode("ascii")
+        except (KeyError, zipfile.BadZipFile, OSError, EOFError, UnicodeDecodeError):
+            raise AffordError(f"{name} is corrupt or was edited: its manifest checksum is missing") from None
+        if seal != _sha256(text):
+            raise AffordError(f"{name} is corrupt or was edited: manifest.json does not match its checksum")
     manifest = _migrate(manifest)
     if kinds is not None:
         wanted = (kinds,) if isinstance(kinds, str) else tuple(kinds)
@@ -251,7 +265,7 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
     members = manifest.get("members")
     if not isinstance(members, dict):
         raise AffordError(f"{name} lists no members; it is corrupt or was edited")
-    present = set(zf.namelist()) - {"manifest.json"}
+    present = set(zf.namelist()) - {"manifest.json", _SEAL}
     if present != set(members):
         extra = sorted(present - set(members)) or sorted(set(members) - present)
         raise AffordError(f"{name} is corrupt or was edited: member {extra[0]} does not match the manifest")

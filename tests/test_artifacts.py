@@ -33,13 +33,20 @@ def _rewrite(path, edit):
     path.write_bytes(buf.getvalue())
 
 
-def _manifest_edit(**changes):
+def _manifest_edit(reseal=False, **changes):
+    """Change manifest fields; ``reseal`` also rewrites the manifest's own checksum, as a
+    forger who knows the format would."""
+    text = {}
+
     def edit(name, data):
+        if name == "manifest.sha256" and reseal:
+            return A._sha256(text["manifest"]).encode()
         if name != "manifest.json":
             return data
         m = json.loads(data)
         m.update(changes)
-        return json.dumps(m).encode()
+        text["manifest"] = json.dumps(m).encode()
+        return text["manifest"]
     return edit
 
 
@@ -121,6 +128,25 @@ def test_an_edited_member_fails_its_checksum(tmp_path):
         A.read_artifact(str(path))
 
 
+def test_an_edited_manifest_fails_its_own_checksum(tmp_path):
+    path = _write(tmp_path, seed=4)
+    _rewrite(path, _manifest_edit(seed=5))
+    with pytest.raises(AffordError, match="manifest.json does not match its checksum"):
+        A.read_artifact(str(path))
+    path = _write(tmp_path, seed=4)
+    _rewrite(path, lambda n, d: None if n == "manifest.sha256" else d)
+    with pytest.raises(AffordError, match="manifest checksum is missing"):
+        A.read_artifact(str(path))
+
+
+def test_schema_1_files_without_a_manifest_checksum_still_read(tmp_path):
+    path = _write(tmp_path, seed=4)
+    v1 = _manifest_edit(schema_version=1)
+    _rewrite(path, lambda n, d: None if n == "manifest.sha256" else v1(n, d))
+    art = A.read_artifact(str(path))
+    assert art.manifest["seed"] == 4 and art.arrays["x"].shape == (2, 3)
+
+
 def test_a_missing_member_is_refused(tmp_path):
     path = _write(tmp_path)
     _rewrite(path, lambda n, d: None if n == "i.npy" else d)
@@ -134,16 +160,11 @@ def test_a_pickled_array_is_refused(tmp_path):
     np.save(buf, np.array([{"a": 1}], dtype=object), allow_pickle=True)
     evil = buf.getvalue()
 
-    def swap(name, data):
-        if name == "x.npy":
-            return evil
-        if name == "manifest.json":
-            m = json.loads(data)
-            m["members"]["x.npy"] = A._sha256(evil)
-            return json.dumps(m).encode()
-        return data
-
-    _rewrite(path, swap)
+    with zipfile.ZipFile(path) as zf:
+        members = json.loads(zf.read("manifest.json"))["members"]
+    members["x.npy"] = A._sha256(evil)
+    reseal = _manifest_edit(reseal=True, members=members)
+    _rewrite(path, lambda name, data: evil if name == "x.npy" else reseal(name, data))
     with pytest.raises(AffordError, match="needs pickle; refused"):
         A.read_artifact(str(path))
 

@@ -44,7 +44,7 @@ def test_inspect_reports_an_interactions_file(interactions):
     assert result.exit_code == 0
     info = json.loads(result.stdout)
     assert info["kind"] == "interactions"
-    assert info["schema_version"] == 1
+    assert info["schema_version"] == 2
     assert len(info["sha256"]) == 64 and info["parents"] == []
     assert len(info["features"]) == 43
     assert {f["channel"] for f in info["features"]} == {"visibility", "position", "shape"}
