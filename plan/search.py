@@ -91,19 +91,23 @@ def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int, held: in
     2 * DISTRUST where the object is in the same situation again (within SAME_PLACE) and
     DISTRUST elsewhere: the model erred there, and would predict the same again.
 
-    A surprise on an object the hand held also costs DISTRUST for every other behaviour on
-    that object while it is held again. Every behaviour starts by opening the hand, so what
+    The hand splits situations in two. A surprise on an object the hand held says nothing
+    about the same behaviour on that object lying on the table (the model sees another
+    object vector, and the behaviour does something else to it), and the other way round.
+    It does say something about every other behaviour on that object while it is held
+    again, which costs DISTRUST too: every behaviour starts by opening the hand, so what
     follows begins with the same drop, and the model saw the held object with the hand
-    hiding its shape: whatever misled it about one behaviour misleads it about the others.
+    hiding its shape, so whatever misled it about one behaviour misleads it about the others.
     """
     f = state[obj, 1:7]
+    now_held = held == obj
     cost = 0.0
     for g, b, i, in_hand in avoid:
-        if i != obj:
+        if i != obj or in_hand != now_held:
             continue
         if b == behavior:
             cost += 2 * DISTRUST if np.abs(f - g[1:7]).max() < SAME_PLACE else DISTRUST
-        elif in_hand and held == obj:
+        elif in_hand:
             cost += DISTRUST
     return cost
 
