@@ -6,7 +6,7 @@ from typing import Annotated
 
 import typer
 
-__all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName"]
+__all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives"]
 
 Seed = Annotated[int, typer.Option("--seed", "-s", min=0, help="Random seed; the same seed gives the same arrays whatever --workers is.")]
 Workers = Annotated[int, typer.Option("--workers", "-w", min=1, max=64, help="Parallel worker processes.")]
@@ -14,3 +14,7 @@ Json = Annotated[bool, typer.Option("--json", help="Print one JSON object instea
 OutputPath = Annotated[str, typer.Option("--output", "-o", help="Where to write the artefact; '-' for stdout.")]
 InputPath = Annotated[str, typer.Argument(help="An afford artefact file, or '-' for stdin.", metavar="PATH|-")]
 SceneName = Annotated[str, typer.Option("--scene", help="A registered scene (see 'afford scenes').")]
+Alternatives = Annotated[int, typer.Option(
+    "--alternatives", min=1, max=10,
+    help="Search this many of the most probable plans and take the one most likely to reach the goal with monitoring "
+         "(each replan too); the others are reported.")]

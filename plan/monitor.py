@@ -24,9 +24,9 @@ import numpy as np
 
 from plan.forward import ForwardModel
 from plan.goals import DEFAULT_TOLERANCE, Goal
-from plan.search import Plan, search
+from plan.search import Plan, best_plans, search
 
-__all__ = ["World", "Execution", "assess", "execute", "mismatch", "reach_probability"]
+__all__ = ["World", "Execution", "assess", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
 
 
 class World(Protocol):
@@ -232,3 +232,40 @@ def assess(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, ma
             imagined_nodes=imagined_nodes, budget=budget, **limits)
     plan.replans_assumed = max_replans
     return plan
+
+
+def rank_plans(model: ForwardModel, start: np.ndarray, goal: Goal, candidates: int = 1, *, max_replans: int = 3,
+               method: str = "best-first", avoid: tuple = (), held: int = -1, rollouts: int = 100, seed: int = 0,
+               imagined_nodes: int = 1000, budget: int = 4000, **limits) -> list[Plan]:
+    """Plans ranked by their probability of reaching the goal with monitoring, best first.
+
+    The search gives the ``candidates`` most probable behaviour sequences
+    (:func:`plan.search.best_plans`; breadth-first chaining gives one); each is assessed
+    (:func:`assess`) and they are sorted by success probability, ties by path probability.
+    The most probable path is not always the one most likely to work: a plan whose likely
+    failure leaves the object where nothing else works ranks below a slightly less probable
+    one whose failures can be repaired. Every candidate's assessment draws the same imagined
+    worlds (the same ``seed``), so the ranking compares plans, not luck.
+    """
+    if method == "best-first":
+        plans = best_plans(model, start, goal, max(1, candidates), avoid=avoid, held=held, **limits)
+    else:
+        plans = [search(model, start, goal, method, avoid=avoid, held=held, **limits)]
+    for plan in plans:
+        assess(model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts, seed=seed,
+               imagined_nodes=imagined_nodes, budget=budget, **limits)
+    return sorted(plans, key=lambda p: (-p.success_probability, -p.path_probability))
+
+
+def ranked_planner(model: ForwardModel, goal: Goal, candidates: int, *, max_replans: int = 3,
+                   method: str = "best-first", **limits) -> Callable[[np.ndarray, tuple, int], Plan] | None:
+    """The planner :func:`execute` replans with when plans are chosen among ``candidates``
+    (None, the plain search, for one)."""
+    if candidates <= 1:
+        return None
+
+    def planner(state: np.ndarray, avoid: tuple, held: int) -> Plan:
+        return rank_plans(model, state, goal, candidates, max_replans=max_replans, method=method, avoid=avoid,
+                          held=held, **limits)[0]
+
+    return planner

@@ -27,7 +27,7 @@ import numpy as np
 from plan.forward import ForwardModel
 from plan.goals import Goal
 
-__all__ = ["PlanStep", "Plan", "best_first", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE"]
+__all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE"]
 
 
 @dataclass(frozen=True)
@@ -150,9 +150,25 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
     only way left is still used. The plan's probabilities stay the model's; only the order
     of the search changes.
     """
+    return best_plans(model, start, goal, 1, max_depth=max_depth, max_nodes=max_nodes,
+                      heuristic_weight=heuristic_weight, avoid=avoid, held=held)[0]
+
+
+def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int, *, max_depth: int = 4,
+               max_nodes: int = 20000, heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1) -> list[Plan]:
+    """The ``n_plans`` most probable plans with different behaviour sequences, best first.
+
+    The search goes on past the first plan until it has popped ``n_plans`` goal nodes whose
+    (behaviour, object, alpha) sequences differ (two outcome paths of the same sequence are
+    one plan to execute), or the frontier or node budget runs out. A failed search returns
+    one plan that says why; otherwise only found plans are returned. Each plan's search
+    effort counts everything expanded up to it.
+    """
     t0 = time.perf_counter()
     if goal.holds(start):
-        return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
+        return [Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")]
+    found: list[Plan] = []
+    sequences: set[tuple] = set()
     counter = 0
     frontier = [(heuristic_weight * goal.distance(start), goal.distance(start), counter, 0.0, start, (), False, held)]
     best_cost: dict[bytes, float] = {_key(start, held): 0.0}
@@ -162,16 +178,23 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
     while frontier:
         _, _, _, cost, state, steps, done, held = heapq.heappop(frontier)
         if done:
+            sequence = tuple((s.behavior, s.obj, s.alpha) for s in steps)
+            if sequence in sequences:
+                continue
+            sequences.add(sequence)
             plan = Plan(True, list(steps), math.exp(-cost), 0.0, expanded, generated, 0.0)
             plan.success_probability = success_probability(model, start, goal, plan.steps)
             plan.seconds = time.perf_counter() - t0
             plan.tree = tree
-            return plan
+            found.append(plan)
+            if len(found) >= n_plans:
+                return found
+            continue
         if len(steps) >= max_depth:
             continue
         if expanded >= max_nodes:
-            return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
-                        f"node budget of {max_nodes} expansions spent", tree)
+            return found or [Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
+                                  f"node budget of {max_nodes} expansions spent", tree)]
         expanded += 1
         # Predictions wait until a node needs them, then come for every vector met so far
         # in one batch per behaviour: scikit-learn's per-call overhead, not the rows, is
@@ -190,21 +213,26 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                     continue  # too many objects still to change in the steps left
                 c = cost - math.log(max(out.probability, 1e-12)) + penalty
                 now_held = obj if model.in_hand(state, out.state, obj) else -1
+                reached = goal.holds(out.state, gaps)
                 k = _key(out.state, now_held)
-                if best_cost.get(k, math.inf) <= c + 1e-12:
-                    continue
-                best_cost[k] = c
+                # a state reached more cheaply before is not searched again; but another way
+                # to the goal is another plan when several are wanted (two sequences that
+                # knock an object off from where it stands end in the same state)
+                if not (reached and n_plans > 1):
+                    if best_cost.get(k, math.inf) <= c + 1e-12:
+                        continue
+                    best_cost[k] = c
                 step = PlanStep(model.names[b], obj, alpha, out.category, out.probability, out.state)
                 h = goal.distance(out.state, gaps)
                 if len(steps) < 1:
                     tree.append({"depth": 1, **step.to_json(), "distance": round(h, 3)})
                 counter += 1
                 heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,),
-                                          goal.holds(out.state, gaps), now_held))
+                                          reached, now_held))
                 if len(steps) + 1 < max_depth:
                     pending.append(out.state[obj])
-    return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
-                f"no plan of at most {max_depth} steps reaches the goal", tree)
+    return found or [Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
+                          f"no plan of at most {max_depth} steps reaches the goal", tree)]
 
 
 def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4,

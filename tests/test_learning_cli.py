@@ -187,6 +187,21 @@ def test_plan_and_execute_in_simulation(pipeline):
         assert out["execution"]["executed"]
 
 
+def test_plan_ranks_alternatives_by_success_probability(pipeline):
+    args = ["plan", str(pipeline / "model.afford"), "--seed", "3", "--reachable", "--goal", "*:visibility=0", "--json"]
+    one = json.loads(ok(args).stdout)
+    out = json.loads(ok(args + ["--alternatives", "3"]).stdout)
+    ranked = [out["plan"]] + out["alternatives"]
+    assert 2 <= len(ranked) <= 3 and "alternatives" not in one
+    chances = [p["success_probability"] for p in ranked]
+    assert chances == sorted(chances, reverse=True)
+    assert len({tuple((s["behavior"], s["object"]) for s in p["steps"]) for p in ranked}) == len(ranked)
+    # the most probable path is one of the candidates, and none is less likely to work than it
+    path = [s["behavior"] for s in one["plan"]["steps"]]
+    assert path in [[s["behavior"] for s in p["steps"]] for p in ranked]
+    assert out["plan"]["success_probability"] >= one["plan"]["success_probability"]
+
+
 def test_plan_episodes_report_rates(pipeline):
     out = json.loads(ok(["plan", str(pipeline / "model.afford"), "--seed", "10", "--episodes", "4", "--reachable",
                          "--goal", "*:visibility=0", "--execute", "--json"]).stdout)

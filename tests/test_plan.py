@@ -9,8 +9,8 @@ from features import object_schema
 from plan.emulate import goal_from_observation
 from plan.forward import BehaviorModel, ForwardModel
 from plan.goals import GoalError, parse_goal
-from plan.monitor import assess, execute, reach_probability
-from plan.search import best_first, breadth_first, inverse_query, success_probability
+from plan.monitor import assess, execute, rank_plans, reach_probability
+from plan.search import best_first, best_plans, breadth_first, inverse_query, success_probability
 
 SCHEMA = object_schema()
 D = len(SCHEMA)
@@ -339,3 +339,46 @@ def test_a_surprise_in_the_hand_is_distrusted_in_the_hand_only():
     # neither lift it and drop it the other way (that would begin with the same drop), nor
     # shun drop-left from the table for what it did in the hand
     assert world.calls == [("lift", 0), ("drop-left", 0), ("drop-left", 0)]
+
+
+class NearOnly:
+    """A 'predictor' with fixed probabilities where x_min < 1, and the last category beyond."""
+
+    def __init__(self, probs):
+        self.classes_ = np.arange(len(probs))
+        self.p = np.asarray(probs, dtype=float)
+
+    def predict_proba(self, X):
+        out = np.tile(self.p, (len(X), 1))
+        out[X[:, 0] >= 1.0] = np.eye(len(self.p))[-1]
+        return out
+
+
+def near_only(name, outcomes):
+    return BehaviorModel(name, NearOnly([p for p, _ in outcomes]), np.array([X_MIN]), np.stack([e for _, e in outcomes]))
+
+
+def test_best_plans_gives_different_sequences_most_probable_first():
+    fm = ForwardModel([THROW, SWEEP])
+    plans = best_plans(fm, scene(0.0), goal("*:visibility=0"), 3, max_depth=2)
+    sequences = [tuple(s.behavior for s in p.steps) for p in plans]
+    assert sequences[:2] == [("sweep",), ("throw",)]
+    assert len(set(sequences)) == len(sequences) == 3
+    probabilities = [p.path_probability for p in plans]
+    assert probabilities == sorted(probabilities, reverse=True)
+    assert [s.behavior for s in best_first(fm, scene(0.0), goal("*:visibility=0")).steps] == ["sweep"]
+
+
+def test_plans_are_ranked_by_their_chance_with_monitoring_not_by_their_path():
+    # 'gamble' usually works but its failure pushes the object where nothing works any more;
+    # 'sweep' works less often along its path, but a failed sweep can be swept again.
+    gamble = near_only("gamble", [(0.95, effect(vanish=True)), (0.05, effect(5.0))])
+    sweep = near_only("sweep", [(0.9, effect(vanish=True)), (0.1, effect(0.05))])
+    fm = ForwardModel([gamble, sweep])
+    g = goal("*:visibility=0")
+    assert [s.behavior for s in best_first(fm, scene(0.0), g).steps] == ["gamble"]
+    ranked = rank_plans(fm, scene(0.0), g, 2, max_replans=3)
+    assert [tuple(s.behavior for s in p.steps) for p in ranked] == [("sweep",), ("gamble",)]
+    assert ranked[0].success_probability > ranked[1].success_probability
+    assert ranked[1].success_probability == pytest.approx(0.95, abs=0.04)  # a failed gamble is not repaired
+    assert rank_plans(fm, scene(0.0), g, 1)[0].steps[0].behavior == "gamble"  # one candidate: the most probable

@@ -10,7 +10,7 @@ import typer
 from afford_cli.commands.plan import render_plan
 from afford_cli.errors import AffordError
 from afford_cli.learning import forward_model, load_model
-from afford_cli.options import Json, SceneName
+from afford_cli.options import Alternatives, Json, SceneName
 from afford_cli.output import Output
 from afford_cli.scenes_io import open_world, scene_objects
 
@@ -25,13 +25,13 @@ def emulate(
     max_nodes: Annotated[int, typer.Option("--max-nodes", min=1)] = 20000,
     max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
     seed: Annotated[int, typer.Option("--seed", "-s", min=0, help="Seed of the simulated worlds (noise).")] = 0,
+    alternatives: Alternatives = 1,
     json: Json = False,
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
     from plan.emulate import goal_from_observation
-    from plan.monitor import assess
     from plan.monitor import execute as run
-    from plan.search import search
+    from plan.monitor import rank_plans, ranked_planner
 
     loaded = load_model(model)
     fm = forward_model(loaded)
@@ -46,14 +46,18 @@ def emulate(
     except ValueError as exc:
         raise AffordError(str(exc)) from None
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}
-    plan = assess(fm, state, goal, search(fm, state, goal, "best-first", **limits), max_replans=max_replans, **limits)
+    ranked = rank_plans(fm, state, goal, alternatives, max_replans=max_replans, **limits)
+    plan = ranked[0]
     result = {"goal": goal.to_json(), "plan": plan.to_json()["steps"], "found": plan.found,
               "success_probability": round(plan.success_probability, 4),
               "open_loop_probability": plan.to_json()["open_loop_probability"], "reached": False, "replans": 0,
               "search": plan.to_json()}
     entry = {"plan": plan.to_json(), "tree": plan.tree[:8]}
+    if alternatives > 1:
+        result["alternatives"] = entry["alternatives"] = [p.to_json() for p in ranked[1:]]
     if execute and plan.found:
-        ex = run(world, fm, goal, max_replans=max_replans, first=plan, **limits)
+        ex = run(world, fm, goal, max_replans=max_replans, first=plan,
+                 planner=ranked_planner(fm, goal, alternatives, max_replans=max_replans, **limits), **limits)
         result.update({"reached": ex.reached, "replans": ex.replans, "execution": ex.to_json()})
         entry["execution"] = ex.to_json()
     elif not plan.found:

@@ -12,7 +12,7 @@ from rich.table import Table
 
 from afford_cli.errors import AffordError
 from afford_cli.learning import forward_model, load_model
-from afford_cli.options import Json, SceneName
+from afford_cli.options import Alternatives, Json, SceneName
 from afford_cli.output import Output
 from afford_cli.scenes_io import open_world, scene_objects
 
@@ -31,21 +31,29 @@ def parse_goals(expressions: list[str], schema):
         raise AffordError(str(exc)) from None
 
 
-def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int) -> dict:
-    """Plan in one scene (and execute with monitoring); the result as plain data."""
-    from plan.monitor import assess
+def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int,
+              alternatives: int = 1) -> dict:
+    """Plan in one scene (and execute with monitoring); the result as plain data.
+
+    With ``alternatives`` > 1 the most probable plans are ranked by their success
+    probability with monitoring, the first is the plan (and every replan is chosen the same
+    way), and the others are reported under ``alternatives``.
+    """
     from plan.monitor import execute as run
-    from plan.search import search
+    from plan.monitor import rank_plans, ranked_planner
 
     world = open_world(scene, specs, seed)
     start = world.perceive()
     model.check_schema(scene.schema, "this scene's perception")
     goal.check_objects(start.shape[0])
-    first = assess(fm, start, goal, search(fm, start, goal, method, **limits), max_replans=max_replans,
-                   method=method, **limits)
+    ranked = rank_plans(fm, start, goal, alternatives, max_replans=max_replans, method=method, **limits)
+    first = ranked[0]
     out = {"seed": seed, "objects": start.shape[0], "plan": first.to_json(), "tree": first.tree[:12]}
+    if alternatives > 1:
+        out["alternatives"] = [p.to_json() for p in ranked[1:]]
     if execute and first.found:
-        result = run(world, fm, goal, method=method, max_replans=max_replans, first=first, **limits)
+        planner = ranked_planner(fm, goal, alternatives, max_replans=max_replans, method=method, **limits)
+        result = run(world, fm, goal, method=method, max_replans=max_replans, first=first, planner=planner, **limits)
         out["execution"] = result.to_json()
         out["reached"] = result.reached
         out["replans"] = result.replans
@@ -71,6 +79,12 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
         table.add_row(str(i), s["behavior"], str(s["object"]), ", ".join(f"{a:.2f}" for a in s["alpha"]) or "-",
                       str(s["category"]), f"{s['probability']:.2f}")
     console.print(table)
+    if entry.get("alternatives"):
+        console.print("other plans, by success probability with monitoring (run blind / along the path):")
+        for rank, a in enumerate(entry["alternatives"], 2):
+            steps = ", ".join(f"{s['behavior']} {s['object']}" for s in a["steps"])
+            console.print(f"  {rank}. {steps}: {a['success_probability']:.2f} ({a['open_loop_probability']:.2f} / "
+                          f"{a['path_probability']:.2f})")
     if entry.get("tree"):
         console.print("search tree, first level (behaviour on object -> category, p, distance to goal):")
         for n in entry["tree"]:
@@ -99,6 +113,7 @@ def plan(
     max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
     episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
     reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
+    alternatives: Alternatives = 1,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
@@ -115,13 +130,13 @@ def plan(
     entries = []
     if episodes == 1:
         sc, specs = scene_objects(scene, seed, objects, layout, reachable)
-        entries.append(plan_once(loaded, fm, sc, specs, base, g, method.value, limits, execute, max_replans))
+        entries.append(plan_once(loaded, fm, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
                 sc, specs = scene_objects(scene, base + e, objects, None, reachable)
                 try:
-                    entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans))
+                    entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
                 except (AffordError, ValueError) as exc:  # e.g. an object hidden behind another
                     entries.append({"seed": base + e, "skipped": str(exc),
                                     "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})
