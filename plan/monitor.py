@@ -24,12 +24,20 @@ import numpy as np
 
 from plan.forward import ForwardModel
 from plan.goals import DEFAULT_TOLERANCE, Goal
-from plan.search import Plan, best_plans, search
+from plan.search import UNREACHABLE, Plan, best_plans, search
 
 __all__ = ["World", "Execution", "assess", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
 
 
 class World(Protocol):
+    """What the executor needs of a world: perceive, and act on a perceived object.
+
+    A world may also say whether its arm carried out the last behaviour, as
+    ``last_executed`` (a bool): an arm does not start a behaviour aimed beyond its reach,
+    and a robot knows when its own arm did not move. Worlds without it are taken to have
+    moved every time.
+    """
+
     def perceive(self) -> np.ndarray: ...
 
     def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray: ...
@@ -86,9 +94,10 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
     run = Execution(False, [plan])
     # (object seen before, behaviour, object, whether the hand held it) of steps that surprised
     failed: list[tuple[np.ndarray, str, int, bool]] = []
+    out_of_reach = ""
     while True:
         if not plan.found:
-            run.reason = f"no plan found ({plan.reason})"
+            run.reason = f"no plan found ({plan.reason}{'; ' + out_of_reach if out_of_reach else ''})"
             return run
         if goal.holds(state):
             run.reached = True
@@ -100,9 +109,15 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             before = state[step.obj].copy()
             state = world.act(step.behavior, step.obj, np.asarray(step.alpha, dtype=float))
             held = step.obj if model.in_hand(previous, state, step.obj) else -1
-            surprised = mismatch(goal, step.predicted, state)
-            if surprised:
-                failed.append((before, step.behavior, step.obj, was_held))
+            if not getattr(world, "last_executed", True):
+                # The arm did not start: the object lies beyond its reach, and no behaviour
+                # will do anything to it there (every plan step expected some change).
+                surprised = out_of_reach = f"the arm cannot reach object {step.obj} where it lies"
+                failed.append((before, UNREACHABLE, step.obj, was_held))
+            else:
+                surprised = mismatch(goal, step.predicted, state)
+                if surprised:
+                    failed.append((before, step.behavior, step.obj, was_held))
             run.executed.append({**step.to_json(), "as_predicted": not surprised, "note": surprised})
             if goal.holds(state):
                 run.reached = True

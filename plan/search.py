@@ -27,7 +27,7 @@ import numpy as np
 from plan.forward import ForwardModel
 from plan.goals import Goal
 
-__all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE"]
+__all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE", "UNREACHABLE"]
 
 
 @dataclass(frozen=True)
@@ -78,6 +78,9 @@ def _key(state: np.ndarray, held: int = -1) -> bytes:
 
 #: Two situations of an object closer than this (metres, every position feature) are the same.
 SAME_PLACE = 0.05
+#: The behaviour of an ``avoid`` entry that says the arm could not reach the object there:
+#: no behaviour on that object is tried again in the same situation.
+UNREACHABLE = "*"
 #: Extra search cost (nats) of a behaviour for each time it surprised the robot on that object
 #: elsewhere: the model erred there once, so the planner trusts it half as much.
 DISTRUST = math.log(2.0)
@@ -98,12 +101,20 @@ def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int, held: in
     again, which costs DISTRUST too: every behaviour starts by opening the hand, so what
     follows begins with the same drop, and the model saw the held object with the hand
     hiding its shape, so whatever misled it about one behaviour misleads it about the others.
+
+    An entry whose behaviour is :data:`UNREACHABLE` says the arm did not start because the
+    object lay beyond its reach: every behaviour on that object in the same situation
+    costs ``inf`` (the search leaves it out).
     """
     f = state[obj, 1:7]
     now_held = held == obj
     cost = 0.0
     for g, b, i, in_hand in avoid:
         if i != obj or in_hand != now_held:
+            continue
+        if b == UNREACHABLE:
+            if np.abs(f - g[1:7]).max() < SAME_PLACE:
+                return math.inf  # the arm did not start there: it cannot, whatever it does
             continue
         if b == behavior:
             cost += 2 * DISTRUST if np.abs(f - g[1:7]).max() < SAME_PLACE else DISTRUST
@@ -204,6 +215,8 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
             pending = []
         for b, obj, alpha in _actions(model, state, goal, held):
             penalty = _distrust(avoid, state, model.names[b], obj, held) if avoid else 0.0
+            if penalty == math.inf:
+                continue
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
                 if _no_op(state, out.state, obj):

@@ -37,6 +37,11 @@ class SimWorld:
         """The tracked objects' feature vectors (k, d); vanished ones have visibility 0."""
         return self.state.copy()
 
+    @property
+    def last_executed(self) -> bool:
+        """Did the arm carry out the last behaviour? (No: its target lay beyond reach.)"""
+        return self.history[-1].executed if self.history else True
+
     def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:
         """Run ``behavior`` on tracked object ``target``; return what is perceived after."""
         if behavior not in self._behaviors:

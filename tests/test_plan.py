@@ -382,3 +382,35 @@ def test_plans_are_ranked_by_their_chance_with_monitoring_not_by_their_path():
     assert ranked[0].success_probability > ranked[1].success_probability
     assert ranked[1].success_probability == pytest.approx(0.95, abs=0.04)  # a failed gamble is not repaired
     assert rank_plans(fm, scene(0.0), g, 1)[0].steps[0].behavior == "gamble"  # one candidate: the most probable
+
+
+class ReachWorld(ScriptedWorld):
+    """A scripted world whose arm does not start on objects from ``x_min >= far``."""
+
+    def __init__(self, state, script, far):
+        super().__init__(state, script)
+        self.far, self.last_executed = far, True
+
+    def act(self, behavior, target, alpha=None):
+        self.last_executed = self.state[target, X_MIN] < self.far
+        if not self.last_executed:
+            self.calls.append((behavior, target))
+            return self.perceive()
+        return super().act(behavior, target, alpha)
+
+
+def test_an_object_the_arm_cannot_reach_is_left_alone():
+    fm = ForwardModel([SWEEP, THROW])
+    world = ReachWorld(scene(0.5, 0.0), {"sweep": [effect(vanish=True)], "throw": [effect(vanish=True)]}, far=0.4)
+    run = execute(world, fm, goal("*:visibility=0"), max_replans=3)
+    assert run.reached and run.replans == 1
+    assert world.calls == [("sweep", 0), ("sweep", 1)]  # nothing else tried on the far object
+    assert "cannot reach object 0" in run.executed[0]["note"]
+
+
+def test_when_the_goal_needs_an_object_out_of_reach_the_robot_says_so():
+    fm = ForwardModel([SWEEP, THROW])
+    world = ReachWorld(scene(0.5), {"sweep": [effect(vanish=True)], "throw": [effect(vanish=True)]}, far=0.4)
+    run = execute(world, fm, goal("0:visibility=0"), max_replans=3)
+    assert not run.reached and run.replans == 1 and len(world.calls) == 1
+    assert run.reason.startswith("no plan found") and "cannot reach object 0 where it lies" in run.reason
