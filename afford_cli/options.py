@@ -17,4 +17,4 @@ SceneName = Annotated[str, typer.Option("--scene", help="A registered scene (see
 Alternatives = Annotated[int, typer.Option(
     "--alternatives", min=1, max=10,
     help="Search this many of the most probable plans and take the one most likely to reach the goal with monitoring "
-         "(each replan too); the others are reported.")]
+         "(each replan too); the others are reported. 1: the most probable plan, assessed alone.")]

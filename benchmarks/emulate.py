@@ -1,6 +1,6 @@
 """Emulation success over varied start layouts (thesis 8.7's three tasks).
 
-    python benchmarks/emulate.py [--model PATH | --interactions 5000] [--layouts 10] [--seed 42] [--max-depth 5] [--tasks clear,lift,close]
+    python benchmarks/emulate.py [--model PATH | --interactions 5000] [--layouts 10] [--seed 42] [--max-depth 5] [--alternatives 3] [--tasks clear,lift,close]
 
 For each task the shown scene is the example layout in examples/layouts, and the start
 scenes are drawn at random (objects small enough to lift, within reach): clear the table
@@ -58,6 +58,7 @@ def main() -> None:
     ap.add_argument("--layouts", type=int, default=10)
     ap.add_argument("--seed", type=int, default=42)
     ap.add_argument("--max-depth", type=int, default=5)
+    ap.add_argument("--alternatives", type=int, default=3, help="as afford emulate --alternatives")
     ap.add_argument("--tasks", default="clear,lift,close")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "emulate.json"))
     args = ap.parse_args()
@@ -65,8 +66,7 @@ def main() -> None:
     from afford_cli.learning import forward_model, load_model
     from afford_cli.scenes_io import open_world
     from plan.emulate import goal_from_observation
-    from plan.monitor import assess, execute
-    from plan.search import search
+    from plan.monitor import execute, rank_plans, ranked_planner
     from sim.layout import load_layout
     from sim.registry import get_scene
 
@@ -79,6 +79,7 @@ def main() -> None:
     result = {"benchmark": "emulate", "tasks": {}}
     limits = {"max_depth": args.max_depth, "max_nodes": 20000}
     result["max_depth"] = args.max_depth
+    result["alternatives"] = args.alternatives
     for task in args.tasks.split(","):
         rng = np.random.default_rng(args.seed)
         runs = []
@@ -90,8 +91,9 @@ def main() -> None:
             fm = forward_model(model)
             goal = goal_from_observation(observed, world.perceive(), model.schema)
             start = world.perceive()
-            plan = assess(fm, start, goal, search(fm, start, goal, **limits), **limits)
-            run = execute(world, fm, goal, first=plan, **limits) if plan.found else None
+            plan = rank_plans(fm, start, goal, args.alternatives, **limits)[0]
+            run = execute(world, fm, goal, first=plan, planner=ranked_planner(fm, goal, args.alternatives, **limits),
+                          **limits) if plan.found else None
             runs.append({"found": plan.found, "reached": bool(run and run.reached), "replans": run.replans if run else 0,
                          "reason": run.reason if run else plan.reason, "length": len(plan.steps),
                          "success_probability": round(plan.success_probability, 4),

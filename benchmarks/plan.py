@@ -6,7 +6,8 @@ Without ``--model`` it explores and trains a model first (the time for that is r
 apart). Each scene draws three objects within reach and asks for all three to be gone
 (plans of three or more steps) and for object 0 to end 20 cm further from the robot.
 Search time is reported apart from the time to estimate the plan's success probability
-with monitoring (``plan.monitor.assess``, which ``afford plan`` adds).
+with monitoring (``plan.monitor.assess``, which ``afford plan`` adds), and from the time to
+rank the three most probable plans by that probability (``--alternatives 3``).
 Prints one JSON object and writes it to ``--out``.
 """
 
@@ -56,7 +57,7 @@ def main() -> None:
     from afford_cli.learning import forward_model, load_model
     from afford_cli.scenes_io import open_world, scene_objects
     from plan.goals import parse_goal
-    from plan.monitor import assess
+    from plan.monitor import assess, rank_plans
     from plan.search import best_first
 
     model = load_model(model_path)
@@ -78,9 +79,12 @@ def main() -> None:
             plan = best_first(fm, state, goal, max_depth=5, max_nodes=20000)
             t0 = time.perf_counter()
             assess(fm, state, goal, plan, max_depth=5, max_nodes=20000)  # what `afford plan` adds
+            assess_s = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            rank_plans(forward_model(model), state, goal, 3, max_depth=5, max_nodes=20000)  # --alternatives 3
             rows.append({"goal": name, "found": plan.found, "length": len(plan.steps), "seconds": plan.seconds,
-                         "assess_seconds": time.perf_counter() - t0, "expanded": plan.expanded,
-                         "generated": plan.generated, "predictions": fm.predictions})
+                         "assess_seconds": assess_s, "rank3_seconds": time.perf_counter() - t0,
+                         "expanded": plan.expanded, "generated": plan.generated, "predictions": fm.predictions})
     secs = np.array([r["seconds"] for r in rows])
     nodes = np.array([r["expanded"] for r in rows])
     result = {
@@ -94,6 +98,8 @@ def main() -> None:
         "nodes_per_second": round(float(nodes.sum() / secs.sum()), 1),
         "success_probability_seconds": {"mean": round(float(np.mean([r["assess_seconds"] for r in rows])), 4),
                                         "max": round(float(np.max([r["assess_seconds"] for r in rows])), 4)},
+        "alternatives_3_seconds": {"mean": round(float(np.mean([r["rank3_seconds"] for r in rows])), 4),
+                                   "max": round(float(np.max([r["rank3_seconds"] for r in rows])), 4)},
         "by_goal": {g: {"found": sum(r["found"] for r in rows if r["goal"] == g),
                         "mean_length": round(float(np.mean([r["length"] for r in rows if r["goal"] == g and r["found"]] or [0])), 2),
                         "mean_seconds": round(float(np.mean([r["seconds"] for r in rows if r["goal"] == g])), 4)}

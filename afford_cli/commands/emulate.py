@@ -25,7 +25,7 @@ def emulate(
     max_nodes: Annotated[int, typer.Option("--max-nodes", min=1)] = 20000,
     max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
     seed: Annotated[int, typer.Option("--seed", "-s", min=0, help="Seed of the simulated worlds (noise).")] = 0,
-    alternatives: Alternatives = 1,
+    alternatives: Alternatives = 3,
     json: Json = False,
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""

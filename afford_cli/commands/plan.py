@@ -32,7 +32,7 @@ def parse_goals(expressions: list[str], schema):
 
 
 def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int,
-              alternatives: int = 1) -> dict:
+              alternatives: int = 3) -> dict:
     """Plan in one scene (and execute with monitoring); the result as plain data.
 
     With ``alternatives`` > 1 the most probable plans are ranked by their success
@@ -113,7 +113,7 @@ def plan(
     max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
     episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
     reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
-    alternatives: Alternatives = 1,
+    alternatives: Alternatives = 3,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
