@@ -12,7 +12,9 @@ holds (one a step raised) and replans with it.
 
 :func:`reach_probability` runs the same executor in worlds drawn from the model, to tell how
 likely a plan is to reach its goal when it is run this way; :func:`assess` stores that on
-the plan next to its open-loop probability.
+the plan next to its open-loop probability, and :func:`rank_plans` orders the most probable
+plans by it. When the world says its arm did not start (the object lay beyond reach), the
+robot leaves that object alone where it lies.
 """
 
 from __future__ import annotations

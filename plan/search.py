@@ -4,8 +4,9 @@
 alpha) together with one predicted outcome category, costing -log P(category). Nodes are
 popped in order of cost plus ``heuristic_weight`` times the goal distance (ties go to the
 node nearer the goal), so with the default weight of 0 the first plan that reaches the
-goal is the most probable one within the limits. ``breadth_first`` is the thesis's forward
-chaining: only each behaviour's most probable outcome, shortest plan first.
+goal is the most probable one within the limits; ``best_plans`` goes on to the next most
+probable behaviour sequences. ``breadth_first`` is the thesis's forward chaining: only each
+behaviour's most probable outcome, shortest plan first.
 
 A plan's *open-loop probability* is the chance that executing its behaviours blind
 reaches the goal at some step, summed over every outcome sequence the model predicts (not
