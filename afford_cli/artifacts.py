@@ -35,7 +35,7 @@ from afford_cli.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
-    "artifact_bytes", "TRUSTED_TYPES", "dump_estimator", "load_estimator", "check_output",
+    "artifact_bytes", "dump_estimator", "load_estimator", "check_output",
 ]
 
 FORMAT = "afford"
@@ -46,9 +46,6 @@ MIN_SCHEMA_VERSION = 1
 KINDS = ("interactions", "effects", "features", "model")
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
 _SEAL = "manifest.sha256"
-
-#: Types an estimator member may contain; anything else is refused on load.
-TRUSTED_TYPES: list[str] = []
 
 
 def _version() -> str:
@@ -84,7 +81,7 @@ class Artifact:
     def parent_ref(self) -> dict[str, str]:
         return {"kind": self.kind, "sha256": self.sha256}
 
-    def estimator(self, name: str, trusted: list[str] | None = None):
+    def estimator(self, name: str, trusted: list[str]):
         """Load estimator member ``name`` with skops, refusing any type not trusted."""
         if name not in self.blobs:
             raise AffordError(f"{self.source} holds no estimator named {name!r}")
@@ -97,7 +94,7 @@ def dump_estimator(estimator) -> bytes:
     return sio.dumps(estimator)
 
 
-def load_estimator(blob: bytes, where: str, trusted: list[str] | None = None):
+def load_estimator(blob: bytes, where: str, trusted: list[str]):
     """skops.io load that refuses, in one sentence, any type outside the trusted list.
 
     skops rebuilds objects from a declarative description and only instantiates types it
@@ -105,7 +102,7 @@ def load_estimator(blob: bytes, where: str, trusted: list[str] | None = None):
     """
     import skops.io as sio
 
-    allowed = set(TRUSTED_TYPES if trusted is None else trusted)
+    allowed = set(trusted)
     try:
         untrusted = sio.get_untrusted_types(data=blob)
     except Exception:

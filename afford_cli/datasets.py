@@ -34,38 +34,67 @@ def outcome_table(data: Interactions) -> dict[str, dict[str, dict[str, int]]]:
     return table
 
 
+def result_rates(data: Interactions) -> dict[str, dict[str, float]]:
+    """Per behaviour, the share of each given result (``{}`` for discovered labels)."""
+    if data.result is None:
+        return {}
+    out = {}
+    for b, name in enumerate(data.behavior_names):
+        r = data.result[data.behavior == b]
+        out[name] = {label: round(float(np.mean(r == i)), 4) if r.size else 0.0
+                     for i, label in enumerate(data.result_names)}
+    return out
+
+
 def interactions_members(data: Interactions) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-    """Arrays and manifest entries of an ``interactions`` artefact."""
+    """Arrays and manifest entries of an ``interactions`` artefact (each entity once)."""
+    data = data.compact()
     data.validate()
     arrays = {k: getattr(data, k) for k in Interactions.ARRAYS}
+    arrays["entities"] = data.entities
+    if data.after_index is not None:
+        arrays["after_index"] = data.after_index
+    if data.result is not None:
+        arrays["result"] = data.result
     arrays.update({_TRUTH + k: v for k, v in data.truth.items()})
     meta = {
         "schema": data.schema.to_json(),
         "behaviors": data.behaviors,
         "scene": data.scene,
         "shapes": list(data.shapes),
-        "outcome_labels": list(OUTCOMES),
+        "outcome_labels": list(OUTCOMES) if "outcome" in data.truth else [],
+        "label_source": data.label_source,
+        "result_names": list(data.result_names),
         "n_interactions": len(data),
         "n_episodes": int(np.unique(data.episode).size),
+        "n_entities": int(data.entities.shape[0]),
         "counts": behaviour_counts(data),
     }
+    if data.result is not None:
+        meta["result_rates"] = result_rates(data)
     return arrays, meta
 
 
 def interactions_from_artifact(art: Artifact) -> Interactions:
     """Rebuild Interactions from an artefact that carries its rows."""
     m = art.manifest
+    a = art.arrays
     try:
         schema = FeatureSchema.from_json(m["schema"])
-        data = Interactions(
-            schema=schema,
-            behaviors=list(m["behaviors"]),
-            **{k: art.arrays[k] for k in Interactions.ARRAYS},
-            truth={k[len(_TRUTH):]: v for k, v in art.arrays.items() if k.startswith(_TRUTH)},
+        rest = dict(
+            truth={k[len(_TRUTH):]: v for k, v in a.items() if k.startswith(_TRUTH)},
             shapes=list(m.get("shapes", [])),
             scene=dict(m.get("scene", {})),
+            result=a.get("result"),
+            result_names=[str(r) for r in m.get("result_names", [])],
         )
-    except (KeyError, TypeError, ValueError) as exc:
+        rows = {k: a[k] for k in ("behavior", "params", "episode", "step")}
+        if "entities" in a:
+            data = Interactions(schema=schema, behaviors=list(m["behaviors"]), entities=a["entities"],
+                                before_index=a["before_index"], after_index=a.get("after_index"), **rows, **rest)
+        else:  # written before entities were stored once: a before and an after per row
+            data = Interactions.from_rows(schema, list(m["behaviors"]), a["before"], a["after"], **rows, **rest)
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise AffordError(f"{art.source} does not hold interaction rows ({exc})") from None
     try:
         data.validate()

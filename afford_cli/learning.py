@@ -75,12 +75,20 @@ def effects_members(data: Interactions, labels: np.ndarray, models: dict, settin
     return arrays, meta, blobs
 
 
-def read_effects(art: Artifact, data: Interactions) -> tuple[np.ndarray, dict]:
-    """Each row's category and the fitted categories per behaviour."""
-    if "category" not in art.arrays or "effects" not in art.manifest:
-        raise AffordError(f"{art.source} holds no effect categories; run 'afford cluster' on it first")
-    models = {name: art.estimator(_blob_name("effects", name), TRUSTED) for name in data.behavior_names}
-    return art.arrays["category"].astype(int), models
+def read_effects(art: Artifact, data: Interactions) -> tuple[np.ndarray, dict | None]:
+    """Each row's label, and the fitted effect categories per behaviour.
+
+    Labels come from one of two sources: categories ``afford cluster`` discovered (then
+    the fitted categories come too), or results given with the interactions, the robot's
+    own success readings (then there are no effect categories: ``None``).
+    """
+    if "category" in art.arrays and "effects" in art.manifest:
+        models = {name: art.estimator(_blob_name("effects", name), TRUSTED) for name in data.behavior_names}
+        return art.arrays["category"].astype(int), models
+    if data.result is not None:
+        return data.result.astype(int), None
+    raise AffordError(f"{art.source} holds no labels: its effects have no categories yet (run 'afford cluster' "
+                      "on it first) and it gives no results")
 
 
 def features_members(art: Artifact, data: Interactions, relevance: dict, settings: dict) -> tuple[dict, dict, dict]:
@@ -88,8 +96,8 @@ def features_members(art: Artifact, data: Interactions, relevance: dict, setting
     meta = {k: v for k, v in art.manifest.items() if k not in _MANIFEST_OWN}
     summary = {}
     for name, fr in relevance.items():
-        arrays[f"selected.{name}"] = np.asarray(fr.selected_, dtype=np.int16)
-        arrays[f"relevance.{name}"] = np.asarray(fr.scores_, dtype=np.float64)
+        arrays[f"selected.{name}"] = np.asarray(fr.selected_, dtype=np.int32)
+        arrays[f"relevance.{name}"] = np.asarray(fr.scores_, dtype=np.float32)
         summary[name] = {**settings, "selected": [data.schema.names[i] for i in fr.selected_],
                          "scores": {data.schema.names[i]: round(float(fr.scores_[i]), 5) for i in fr.ranking_}}
     meta["relevance"] = summary
@@ -107,29 +115,40 @@ def read_selection(art: Artifact, data: Interactions) -> dict[str, np.ndarray]:
 _MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created", "command", "seed", "parents", "members"}
 
 
-def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict, selected: dict,
+def result_report(data: Interactions, labels: np.ndarray, b: int) -> list[dict]:
+    """Per given result: id, name and count (the categories of a model whose labels were given)."""
+    rows = np.flatnonzero(data.behavior == b)
+    return [{"id": i, "name": name, "count": int((labels[rows] == i).sum())} for i, name in enumerate(data.result_names)]
+
+
+def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict | None, selected: dict,
                   predictors: dict, settings: dict, known: dict | None = None) -> tuple[dict, dict, dict]:
-    from learn.affordances import behaviour_rows, known_columns, n_params, predictor_inputs
+    from learn.affordances import behaviour_rows, known_columns, parameters_of, predictor_inputs
 
     arrays, blobs, cv, categories = {}, {}, {}, {}
     for b, name in enumerate(data.behavior_names):
-        ec, model = effects[name], predictors[name]
+        model = predictors[name]
         rows = behaviour_rows(data, b, labels)
-        arrays[f"prototypes.{name}"] = ec.prototypes_
-        arrays[f"selected.{name}"] = np.asarray(selected[name], dtype=np.int16)
-        arrays[f"train_X.{name}"] = predictor_inputs(data.before[rows], data.params[rows], selected[name], n_params(data, b))
+        if effects is not None:
+            ec = effects[name]
+            arrays[f"prototypes.{name}"] = ec.prototypes_
+            blobs[_blob_name("effects", name)] = dump_estimator(ec)
+        arrays[f"selected.{name}"] = np.asarray(selected[name], dtype=np.int32)
+        arrays[f"train_X.{name}"] = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b)).astype(np.float32)
         arrays[f"train_y.{name}"] = labels[rows].astype(np.int16)
-        blobs[_blob_name("effects", name)] = dump_estimator(ec)
         blobs[_blob_name("predictor", name)] = dump_estimator(model)
         if known and known.get(name) is not None:
             blobs[_blob_name("known", name)] = dump_estimator(known[name])
             arrays[f"known_selected.{name}"] = known_columns(data.schema).astype(np.int16)
         cv[name] = model.cv_report_
-        categories[name] = category_report(data, labels, b, ec.prototypes_)
+        categories[name] = (category_report(data, labels, b, effects[name].prototypes_) if effects is not None
+                            else result_report(data, labels, b))
     meta = {
         "schema": data.schema.to_json(),
         "behaviors": data.behaviors,
         "scene": data.scene,
+        "label_source": "discovered" if effects is not None else "given",
+        "result_names": [] if effects is not None else list(data.result_names),
         "training": {**settings, "n_interactions": len(data)},
         "effects": art.manifest.get("effects", {}),
         "relevance": {name: {"selected": [data.schema.names[i] for i in selected[name]]} for name in data.behavior_names},
@@ -148,9 +167,12 @@ class LoadedModel:
         self.schema = FeatureSchema.from_json(m["schema"])
         self.behaviors = list(m["behaviors"])
         self.names = [b["name"] for b in self.behaviors]
+        self.label_source = str(m.get("label_source", "discovered"))
+        self.result_names = [str(r) for r in m.get("result_names", [])]
         self.selected = {n: art.arrays[f"selected.{n}"].astype(int) for n in self.names}
-        self.prototypes = {n: art.arrays[f"prototypes.{n}"] for n in self.names}
-        self.effects = {n: art.estimator(_blob_name("effects", n), TRUSTED) for n in self.names}
+        given = self.label_source == "given"
+        self.prototypes = {n: None if given else art.arrays[f"prototypes.{n}"] for n in self.names}
+        self.effects = {n: None if given else art.estimator(_blob_name("effects", n), TRUSTED) for n in self.names}
         self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED) for n in self.names}
         self.known = {n: art.estimator(_blob_name("known", n), TRUSTED) if _blob_name("known", n) in art.blobs else None
                       for n in self.names}
@@ -158,8 +180,14 @@ class LoadedModel:
         self.known_selected = {n: art.arrays[f"known_selected.{n}"].astype(int) if f"known_selected.{n}" in art.arrays
                                else self.selected[n] for n in self.names}
 
-    def n_params(self, name: str) -> int:
-        return len(self.behaviors[self.names.index(name)].get("parameters", []))
+    def parameters(self, name: str) -> list[dict]:
+        return list(self.behaviors[self.names.index(name)].get("parameters", []))
+
+    def check_effects(self, what: str) -> None:
+        """Refuse, in one sentence, a use that needs predicted effects from a model whose labels were given."""
+        if self.label_source == "given":
+            raise AffordError(f"{what} needs a model that predicts effects, but this model's labels were given "
+                              f"({'/'.join(self.result_names)}): it predicts whether a behaviour succeeds, not what changes")
 
     def check_schema(self, schema: FeatureSchema, what: str) -> None:
         if schema != self.schema:
@@ -177,12 +205,10 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02):
 
     behaviors = []
     for b, name in enumerate(model.names):
-        params = [(float(p["low"]), float(p["high"])) for p in model.behaviors[b].get("parameters", [])]
+        spec = model.behaviors[b]
+        params = [(float(p["low"]), float(p["high"])) for p in spec.get("parameters", [])]
         behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params,
-                                       known=model.known[name], known_selected=model.known_selected[name]))
-    names = model.schema.names
-    histograms = [np.array([i for i, n in enumerate(names) if n.startswith(prefix + "_")])
-                  for prefix in ("elevation", "azimuth")]
-    height = names.index("z_min") if "z_min" in names else None
-    return ForwardModel(behaviors, min_probability=min_probability, histograms=[h for h in histograms if h.size],
-                        height=height)
+                                       known=model.known[name], known_selected=model.known_selected[name],
+                                       periodic=tuple(bool(p.get("periodic")) for p in spec.get("parameters", [])),
+                                       target=spec.get("target", "object")))
+    return ForwardModel(behaviors, model.schema, min_probability=min_probability)

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 
-__all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives"]
+__all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives", "SceneSeed", "Objects",
+           "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source"]
 
 Seed = Annotated[int, typer.Option("--seed", "-s", min=0, help="Random seed; the same seed gives the same arrays whatever --workers is.")]
 Workers = Annotated[int, typer.Option("--workers", "-w", min=1, max=64, help="Parallel worker processes.")]
@@ -18,3 +19,20 @@ Alternatives = Annotated[int, typer.Option(
     "--alternatives", min=1, max=10,
     help="Search this many of the most probable plans and take the one most likely to reach the goal with monitoring "
          "(each replan too); the others are reported. 1: the most probable plan, assessed alone.")]
+
+# -- where a command acts: a drawn scene or a pinned layout, and the planner's limits ------
+SceneSeed = Annotated[Optional[int], typer.Option("--seed", "-s", min=0, help="Draw a random scene from this seed.")]
+Objects = Annotated[Optional[int], typer.Option("--objects", min=1, max=6, help="Objects in a drawn scene (scenes that have objects to act on).")]
+Layout = Annotated[Optional[str], typer.Option("--layout", help="A TOML layout file that pins the scene.")]
+MaxDepth = Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")]
+MaxNodes = Annotated[int, typer.Option("--max-nodes", min=1, help="Most search nodes to expand.")]
+MaxReplans = Annotated[int, typer.Option("--max-replans", min=0, max=20, help="Most replans after surprises.")]
+
+
+def check_scene_source(layout: Optional[str], seed: Optional[int], **drawn) -> None:
+    """``--layout`` pins the scene; ``--seed`` (with the drawing options, given when set) draws one; not both."""
+    if layout is not None and (seed is not None or any(v is not None for v in drawn.values())):
+        extra = ", ".join(["--seed"] + [f"--{k.replace('_', '-')}" for k in drawn])
+        raise typer.BadParameter(f"--layout pins the scene; it does not go with {extra}")
+    if layout is None and seed is None:
+        raise typer.BadParameter("give --layout FILE, or --seed S to draw a random scene")

@@ -18,6 +18,7 @@ once saved.
 from __future__ import annotations
 
 import re
+import os
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -95,9 +96,9 @@ def artefact_plots(info: dict, directory: Path) -> list[str]:
     paths = []
     features = info.get("features") or []
     for name, report in (info.get("behaviors") or {}).items():
-        if report.get("categories"):
+        if report.get("categories") and "prototype" in report["categories"][0]:
             paths.append(prototypes_figure(directory / _file_name("prototypes", name), name,
-                                           report["categories"], features))
+                                           report["categories"], features, info.get("histogram_columns")))
         if report.get("relevance") or report.get("selected"):
             paths.append(relevance_figure(directory / _file_name("relevance", name), name,
                                           report.get("relevance"), report.get("selected", []), len(features)))
@@ -127,15 +128,18 @@ def _channels(features: list[dict], categories: list[dict]) -> list[tuple[str, l
     return list(out.items())
 
 
-def _groups(names: list[str]) -> list[tuple[str, int, int]]:
-    """Runs of names sharing a prefix (``elevation_00..17`` -> ``elevation``): (prefix, start, stop)."""
-    runs: list[tuple[str, int, int]] = []
-    for i, n in enumerate(names):
-        prefix = n.rsplit("_", 1)[0]
-        if runs and runs[-1][0] == prefix:
-            runs[-1] = (prefix, runs[-1][1], i + 1)
-        else:
-            runs.append((prefix, i, i + 1))
+def _groups(names: list[str], columns: dict[str, int], histograms: list) -> list[tuple[str, int, int]]:
+    """The schema's histograms among a channel's ``names``, as (label, start, stop) in that list.
+
+    The label is what the histogram's first and last feature names share (``elevation``).
+    """
+    local = {columns[n]: i for i, n in enumerate(names) if n in columns}
+    runs = []
+    for a, b in histograms:
+        if a in local and b - 1 in local:
+            first, last = names[local[a]], names[local[b - 1]]
+            label = os.path.commonprefix([first, last]).rstrip("_0123456789") or first
+            runs.append((label, local[a], local[b - 1] + 1))
     return runs
 
 
@@ -146,7 +150,8 @@ def _dominant(outcomes: dict) -> str:
     return f"{label} {100 * share:.0f}%"
 
 
-def prototypes_figure(path: Path, behavior: str, categories: list[dict], features: list[dict]) -> str:
+def prototypes_figure(path: Path, behavior: str, categories: list[dict], features: list[dict],
+                      histograms: list | None = None) -> str:
     """One row of signed bar panels per effect category, one panel per channel (thesis fig. 8.4-8.7).
 
     Each row is labelled with the category id, its member count and the ground-truth outcome
@@ -154,6 +159,7 @@ def prototypes_figure(path: Path, behavior: str, categories: list[dict], feature
     down, on one scale per channel.
     """
     channels = _channels(features, categories)
+    columns = {f["name"]: i for i, f in enumerate(features)}
     n_rows, n_cols = len(categories), len(channels)
     widths = [max(0.9, len(names) ** 0.6) for _, names in channels]
     fig = _new_figure(1.6 + 1.0 * sum(widths), 1.3 + 0.72 * n_rows)
@@ -161,7 +167,7 @@ def prototypes_figure(path: Path, behavior: str, categories: list[dict], feature
     for j, (channel, names) in enumerate(channels):
         scale = max((abs(c["prototype"].get(n, 0.0)) for c in categories for n in names), default=0.0) or 1.0
         x = range(len(names))
-        groups = _groups(names)
+        groups = _groups(names, columns, histograms or [])
         for i, cat in enumerate(categories):
             ax = axes[i, j]
             values = [cat["prototype"].get(n, 0.0) for n in names]
@@ -172,8 +178,9 @@ def prototypes_figure(path: Path, behavior: str, categories: list[dict], feature
             for side in ("top", "right"):
                 ax.spines[side].set_visible(False)
             if len(names) > 8:
-                for _, start, _stop in groups[1:]:
-                    ax.axvline(start - 0.5, color="#999999", linewidth=0.6, linestyle=":")
+                for _, start, _stop in groups:
+                    if start > 0:
+                        ax.axvline(start - 0.5, color="#999999", linewidth=0.6, linestyle=":")
             # Only the bottom row carries ticks (one scale per column): ticks are most of the drawing time.
             if i < n_rows - 1:
                 ax.set_xticks([])
@@ -184,7 +191,7 @@ def prototypes_figure(path: Path, behavior: str, categories: list[dict], feature
                 ax.set_yticks([-scale, 0.0, scale], [f"{-scale:.2g}", "0", f"{scale:.2g}"])
                 if 1 < len(names) <= 8:
                     ax.set_xticks(list(x), names, rotation=90)
-                elif len(names) > 8 and len(groups) < len(names):
+                elif len(names) > 8 and groups and len(groups) < len(names):
                     ax.set_xticks([(a + b - 1) / 2 for _, a, b in groups], [g for g, _, _ in groups])
                 else:
                     ax.set_xticks([])

@@ -6,7 +6,7 @@ from rich import box
 from rich.table import Table
 from rich.text import Text
 
-__all__ = ["bar_row", "render_categories", "render_outcome_table", "render_metrics"]
+__all__ = ["bar_row", "render_categories", "render_outcome_table", "render_metrics", "render_result_rates"]
 
 _GLYPHS = " ▁▂▃▄▅▆▇█"
 
@@ -82,4 +82,18 @@ def render_metrics(console, behaviors: dict, title: str) -> None:
             b = m.get("baselines", {})
             row += [f"{100 * b[k]:.1f}%" for k in ("majority", "knn", "random_forest")]
         table.add_row(*row)
+    console.print(table)
+
+
+def render_result_rates(console, rates: dict[str, dict[str, float]]) -> None:
+    """Per behaviour, the share of each result the robot read off its own sensors."""
+    if not rates:
+        return
+    names = list(next(iter(rates.values())))
+    table = Table(title="the robot's own results per behaviour", box=box.SIMPLE_HEAD)
+    table.add_column("behaviour", no_wrap=True)
+    for n in names:
+        table.add_column(n, justify="right")
+    for b, r in rates.items():
+        table.add_row(b, *[f"{100 * r[n]:.1f} %" for n in names])
     console.print(table)

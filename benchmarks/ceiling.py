@@ -63,9 +63,9 @@ def main() -> None:
 
     def labelled(d, name):
         rows = np.flatnonzero(d.behavior == d.behavior_names.index(name))
-        y = model.effects[name].assign(d.effects[rows])
+        y = model.effects[name].assign(d.effects_of(rows))
         rows, y = rows[y >= 0], y[y >= 0]  # effects of a kind the model discarded are not counted
-        perceived = predictor_inputs(d.before[rows], d.params[rows], model.selected[name], model.n_params(name))
+        perceived = predictor_inputs(d.before_rows(rows), d.params[rows], model.selected[name], model.parameters(name))
         return perceived, true_state(d, rows), y
 
     result: dict = {"model": args.model, "data": args.data, "behaviors": {}}

@@ -48,9 +48,9 @@ def main() -> None:
 
     def labelled(d, name):
         rows = np.flatnonzero(d.behavior == d.behavior_names.index(name))
-        y = model.effects[name].assign(d.effects[rows])
+        y = model.effects[name].assign(d.effects_of(rows))
         keep = y >= 0  # effects of a kind the model discarded are not counted
-        X = predictor_inputs(d.before[rows[keep]], d.params[rows[keep]], model.selected[name], model.n_params(name))
+        X = predictor_inputs(d.before_rows(rows[keep]), d.params[rows[keep]], model.selected[name], model.parameters(name))
         return X, y[keep]
 
     result: dict = {"model": args.model, "data": args.data, "test": args.test, "behaviors": {}}

@@ -55,7 +55,7 @@ def main() -> None:
     build_s = None if args.model else round(time.perf_counter() - t, 1)
 
     from afford_cli.learning import forward_model, load_model
-    from afford_cli.scenes_io import open_world, scene_objects
+    from afford_cli.scenes_io import open_world, scene_layout
     from plan.goals import parse_goal
     from plan.monitor import assess, rank_plans
     from plan.search import best_first
@@ -67,7 +67,7 @@ def main() -> None:
     }
     rows = []
     for s in range(args.scenes):
-        scene, specs = scene_objects("table", args.seed + s, 3, None, reachable=True)
+        scene, specs = scene_layout("table", args.seed + s, None, objects=3, reachable=True)
         state = open_world(scene, specs, args.seed + s).perceive()
         if state.shape[0] < 3:
             continue

@@ -15,12 +15,24 @@ from features.detect import Detection, RangeImage, RegionOfInterest, detect_obje
 from features.normals import grid_normals, normal_angles
 from features.schema import N_ANGLE_BINS, object_schema
 
-__all__ = ["object_features", "perceive", "track", "N_OBJECT_FEATURES", "POSITION", "SHAPE"]
+__all__ = ["object_features", "perceive", "track", "extents", "centres", "N_OBJECT_FEATURES"]
 
 _SCHEMA = object_schema()
 N_OBJECT_FEATURES = len(_SCHEMA)
-POSITION = _SCHEMA.channel_indices("position")
-SHAPE = _SCHEMA.channel_indices("shape")
+_VISIBLE = _SCHEMA.visibility_index
+_LO = np.array([_SCHEMA.index(f"{a}_min") for a in "xyz"])
+_HI = np.array([_SCHEMA.index(f"{a}_max") for a in "xyz"])
+
+
+def extents(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The lowest and highest corner (..., 3) of perceived objects' bounding boxes."""
+    return f[..., _LO], f[..., _HI]
+
+
+def centres(f: np.ndarray) -> np.ndarray:
+    """Centres (..., 3) of perceived objects' bounding boxes."""
+    lo, hi = extents(f)
+    return (lo + hi) / 2
 
 _ELEVATION_EDGES = np.linspace(-90.0, 90.0, N_ANGLE_BINS + 1)
 _AZIMUTH_EDGES = np.linspace(-180.0, 180.0, N_ANGLE_BINS + 1)
@@ -56,11 +68,6 @@ def perceive(image: RangeImage, roi: RegionOfInterest, **detect_options) -> np.n
     return np.stack([object_features(d, image.origin) for d in detections])
 
 
-def _centre(f: np.ndarray) -> np.ndarray:
-    p = f[..., POSITION]
-    return np.stack([(p[..., 0] + p[..., 1]) / 2, (p[..., 2] + p[..., 3]) / 2, (p[..., 4] + p[..., 5]) / 2], axis=-1)
-
-
 def track(known: np.ndarray, seen: np.ndarray, gate: float = 0.35) -> np.ndarray:
     """Match a new look to known objects by their centres.
 
@@ -80,15 +87,16 @@ def track(known: np.ndarray, seen: np.ndarray, gate: float = 0.35) -> np.ndarray
     robot tracks the objects it started with).
     """
     out = known.copy()
-    out[:, 0] = 0.0
+    out[:, _VISIBLE] = 0.0
     if known.shape[0] == 0 or seen.shape[0] == 0:
         return out
-    cost = np.linalg.norm(_centre(known)[:, None, :] - _centre(seen)[None, :, :], axis=2)
+    cost = np.linalg.norm(centres(known)[:, None, :] - centres(seen)[None, :, :], axis=2)
     # An object already gone is matched only when no visible one can take the detection:
     # otherwise a dropped object landing near where another fell off would be mistaken for it.
-    cost = cost + np.where(known[:, 0] < 0.5, gate, 0.0)[:, None]
+    gone = ~_SCHEMA.visible(known)
+    cost = cost + np.where(gone, gate, 0.0)[:, None]
     rows, cols = linear_sum_assignment(cost)
     for r, c in zip(rows, cols):
-        if cost[r, c] - (gate if known[r, 0] < 0.5 else 0.0) <= gate:
+        if cost[r, c] - (gate if gone[r] else 0.0) <= gate:
             out[r] = seen[c]
     return out

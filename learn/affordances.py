@@ -19,13 +19,14 @@ from typing import Callable
 import numpy as np
 
 from features import Interactions
+from features.interactions import encode_parameters
 from learn.effects import EffectCategories
 from learn.predictors import AffordancePredictor
 from learn.relevance import FeatureRelevance, feature_groups
 
 __all__ = [
     "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",
-    "behaviour_seed", "known_columns", "train_known",
+    "behaviour_seed", "known_columns", "train_known", "parameters_of",
 ]
 
 #: Fewest interactions of one behaviour worth learning from.
@@ -44,13 +45,15 @@ def behaviour_rows(data: Interactions, b: int, labels: np.ndarray | None = None)
     return np.flatnonzero(mask)
 
 
-def n_params(data: Interactions, b: int) -> int:
-    return len(data.behaviors[b].get("parameters", []))
+def parameters_of(data: Interactions, b: int) -> list[dict]:
+    """Behaviour ``b``'s parameter list (as artefacts store it)."""
+    return list(data.behaviors[b].get("parameters", []))
 
 
-def predictor_inputs(before: np.ndarray, params: np.ndarray, selected: np.ndarray, k: int) -> np.ndarray:
-    """The predictor's input: selected object features, then the behaviour's k parameters."""
-    return np.hstack([before[:, selected], params[:, :k]])
+def predictor_inputs(before: np.ndarray, params: np.ndarray, selected: np.ndarray, parameters: list[dict]) -> np.ndarray:
+    """The predictor's input: the selected entity features, then the behaviour's parameters
+    (periodic ones as sine and cosine, :func:`features.encode_parameters`)."""
+    return np.hstack([before[:, selected], encode_parameters(params, parameters)])
 
 
 def _check_rows(data: Interactions, b: int, rows: np.ndarray, what: str) -> None:
@@ -75,7 +78,7 @@ def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max:
     for b, name in enumerate(data.behavior_names):
         rows = behaviour_rows(data, b)
         _check_rows(data, b, rows, "clustering")
-        X = np.hstack([data.before[rows], data.params[rows, : n_params(data, b)]])
+        X = predictor_inputs(data.before_rows(rows), data.params[rows], np.arange(len(data.schema)), parameters_of(data, b))
         ec = EffectCategories(schema=tuple(data.schema.channels), method=method, k_max=k_max, k=k, prune=prune,
                               min_fraction=min_fraction, random_state=behaviour_seed(seed, b))
         ec.fit(effects[rows], X)
@@ -98,7 +101,7 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
         if np.unique(y).size < 2:
             raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to tell apart")
         fr = FeatureRelevance(method=method, top=top, feature_groups=groups, random_state=behaviour_seed(seed, b))
-        out[name] = fr.fit(data.before[rows], y)
+        out[name] = fr.fit(data.before_rows(rows), y)
         if progress is not None:
             progress(b + 1)
     return out
@@ -126,7 +129,7 @@ def train_known(data: Interactions, labels: np.ndarray, *, seed: int = 0, min_ro
         if min(known.sum(), (1 - known).sum()) < min_rows:
             out[name] = None
             continue
-        X = predictor_inputs(data.before[rows], data.params[rows], known_columns(data.schema), n_params(data, b))
+        X = predictor_inputs(data.before_rows(rows), data.params[rows], known_columns(data.schema), parameters_of(data, b))
         out[name] = AffordancePredictor(kernel="rbf", calibration="sigmoid", random_state=behaviour_seed(seed, b)).fit(X, known)
     return out
 
@@ -147,7 +150,7 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
         y = labels[rows]
         if np.unique(y).size < 2:
             raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to predict")
-        X = predictor_inputs(data.before[rows], data.params[rows], selected[name], n_params(data, b))
+        X = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b))
         out[name] = AffordancePredictor(kernel=kernel, n_jobs=n_jobs, random_state=behaviour_seed(seed, b)).fit(X, y)
         if progress is not None:
             progress(b + 1)

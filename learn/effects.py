@@ -42,7 +42,8 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import check_array, check_is_fitted
 
 from features.schema import FeatureSchema
-from learn.xmeans import XMeans, _check_finite
+from learn.validation import check_finite
+from learn.xmeans import XMeans
 
 __all__ = ["EffectCategories"]
 
@@ -237,7 +238,7 @@ class EffectCategories(BaseEstimator):
         """
         self._validate_params()
         E = check_array(E, dtype=np.float64, ensure_all_finite=False, ensure_min_samples=2, input_name="E")
-        _check_finite(E, "E")
+        check_finite(E, "E")
         n, d = E.shape
         self.n_features_in_ = d
         if self.prune == "predictability":
@@ -246,7 +247,7 @@ class EffectCategories(BaseEstimator):
                     "prune='predictability' needs the initial object features: call fit(E, X)."
                 )
             X = check_array(X, dtype=np.float64, ensure_all_finite=False, input_name="X")
-            _check_finite(X, "X")
+            check_finite(X, "X")
             if X.shape[0] != n:
                 raise ValueError(f"X has {X.shape[0]} rows but E has {n}; they must describe the same interactions.")
         if self.method == "kmeans" and self.k is not None and self.k > n:
@@ -433,7 +434,7 @@ class EffectCategories(BaseEstimator):
         """Checked effects, in the scaled units the categories were found in."""
         check_is_fitted(self)
         E = check_array(E, dtype=np.float64, ensure_all_finite=False, input_name="E")
-        _check_finite(E, "E")
+        check_finite(E, "E")
         if E.shape[1] != self.n_features_in_:
             raise ValueError(
                 f"E has {E.shape[1]} features, but EffectCategories is expecting "

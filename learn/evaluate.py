@@ -15,7 +15,7 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
 
-from learn.xmeans import _check_finite
+from learn.validation import check_finite
 
 __all__ = ["baseline_scores", "evaluate_predictions", "reliability_bins"]
 
@@ -134,7 +134,7 @@ def _check_predictions(y_true, proba, classes) -> tuple[np.ndarray, np.ndarray, 
         )
     if y_true.shape[0] == 0:
         raise ValueError("there is nothing to evaluate: y_true is empty.")
-    _check_finite(proba, "proba")
+    check_finite(proba, "proba")
     return y_true, proba, classes
 
 
@@ -181,8 +181,8 @@ def baseline_scores(X_train, y_train, X_test, y_test, random_state=None) -> dict
     X_test = np.asarray(X_test, dtype=np.float64)
     y_train = np.asarray(y_train)
     y_test = np.asarray(y_test)
-    _check_finite(X_train, "X_train")
-    _check_finite(X_test, "X_test")
+    check_finite(X_train, "X_train")
+    check_finite(X_test, "X_test")
     if X_train.ndim != 2 or X_test.ndim != 2 or X_train.shape[1] != X_test.shape[1]:
         raise ValueError(
             f"X_train and X_test must be 2-D with the same number of features: got shapes "

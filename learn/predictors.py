@@ -39,7 +39,7 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from learn.xmeans import _check_finite
+from learn.validation import check_finite
 
 __all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
 
@@ -210,7 +210,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         """
         self._validate_params()
         X, y = validate_data(self, X, y, dtype=np.float64, ensure_all_finite=False)
-        _check_finite(X)
+        check_finite(X)
         check_classification_targets(y)
         self.classes_, y_idx = np.unique(y, return_inverse=True)
         if self.classes_.size < 2:
@@ -286,7 +286,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
-        _check_finite(X)
+        check_finite(X)
         proba = np.zeros((X.shape[0], self.classes_.size))
         proba[:, self.calibrated_.classes_] = self.calibrated_.predict_proba(X)
         return proba

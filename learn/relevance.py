@@ -26,7 +26,6 @@ the hundreds of candidate fits of a wrapper take minutes. Pass ``estimator=`` to
 from __future__ import annotations
 
 import numbers
-import re
 import warnings
 
 import numpy as np
@@ -40,7 +39,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_array, check_is_fitted, validate_data
 
 from features.schema import FeatureSchema
-from learn.xmeans import _check_finite
+from learn.validation import check_finite
 
 __all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "ranking_prefix", "relieff"]
 
@@ -50,7 +49,7 @@ _CHUNK = 256
 
 def _check_Xy(X, y, min_rows: int = 2):
     X = check_array(X, dtype=np.float64, ensure_all_finite=False)
-    _check_finite(X)
+    check_finite(X)
     y = np.asarray(y)
     if y.ndim != 1 or y.shape[0] != X.shape[0]:
         raise ValueError(f"y must be one label per row of X: X has {X.shape[0]} rows, y has shape {y.shape}.")
@@ -64,16 +63,15 @@ def _check_Xy(X, y, min_rows: int = 2):
 
 
 def feature_groups(schema) -> np.ndarray:
-    """Group label per feature: features ``<prefix>_<number>`` of one channel form one group.
+    """Group label per feature, as the schema declares: each histogram is one group.
 
-    This makes each 18-bin normal-angle histogram (``elevation_00`` ... ``elevation_17``)
-    one unit for the wrappers, as in the thesis's Schemata search; every other feature
-    (``visibility``, ``x_min``, ...) is a group of its own.
+    This makes each 18-bin normal-angle histogram one unit for the wrappers, as in the
+    thesis's Schemata search; every other feature is a group of its own.
 
     Parameters
     ----------
     schema : FeatureSchema or sequence of str
-        A schema, or feature names (each then counts as its own channel).
+        A schema, or feature names (each then its own group).
 
     Returns
     -------
@@ -81,16 +79,8 @@ def feature_groups(schema) -> np.ndarray:
         Integer group labels, numbered in order of first appearance.
     """
     if isinstance(schema, FeatureSchema):
-        names, channels = schema.names, schema.channels
-    else:
-        names = tuple(str(n) for n in schema)
-        channels = names
-    keys = []
-    for name, channel in zip(names, channels):
-        m = re.fullmatch(r"(.+)_\d+", name)
-        keys.append((channel, m.group(1)) if m else (channel, name, "single"))
-    index = {k: i for i, k in enumerate(dict.fromkeys(keys))}
-    return np.array([index[k] for k in keys], dtype=int)
+        return schema.groups()
+    return np.arange(len(tuple(schema)), dtype=int)
 
 
 def relieff(X, y, n_samples=1000, n_neighbors=10, random_state=None) -> np.ndarray:
@@ -624,5 +614,5 @@ class FeatureRelevance(BaseEstimator):
         """
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
-        _check_finite(X)
+        check_finite(X)
         return X[:, self.selected_]

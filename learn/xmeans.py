@@ -34,24 +34,14 @@ from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from learn.validation import check_finite
+
 __all__ = ["XMeans", "bic_score"]
 
 # A variance of exactly zero (a cluster of identical rows) makes the Gaussian likelihood
 # infinite; it is floored at this fraction of the data's mean per-feature variance, which
 # still makes every split into exact duplicates win, as it should.
 _VARIANCE_FLOOR = 1e-6
-
-
-def _check_finite(X: np.ndarray, what: str = "X") -> None:
-    """Raise one ValueError sentence when an array holds NaN or infinite values."""
-    finite = np.isfinite(X)
-    if not finite.all():
-        bad = np.argwhere(~finite)[0]
-        where = f"row {bad[0]}" + (f", column {bad[1]}" if bad.size > 1 else "")
-        raise ValueError(
-            f"{what} contains NaN or infinite values (first at {where}); "
-            "drop or repair those rows before learning."
-        )
 
 
 def bic_score(X: np.ndarray, labels: np.ndarray, centers: np.ndarray, variance_floor: float = 0.0) -> float:
@@ -172,7 +162,7 @@ class XMeans(ClusterMixin, BaseEstimator):
         """
         self._validate_params()
         X = validate_data(self, X, dtype=[np.float64, np.float32], ensure_all_finite=False)
-        _check_finite(X)
+        check_finite(X)
         X = np.asarray(X, dtype=np.float64)
         if self.k_min > self.k_max:
             raise ValueError(f"k_min={self.k_min} is larger than k_max={self.k_max}.")
@@ -259,5 +249,5 @@ class XMeans(ClusterMixin, BaseEstimator):
         """
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=[np.float64, np.float32], ensure_all_finite=False)
-        _check_finite(X)
+        check_finite(X)
         return _nearest(np.asarray(X, dtype=np.float64), self.cluster_centers_)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from features import FeatureSchema
-from plan.goals import DEFAULT_TOLERANCE, Constraint, Goal
+from plan.goals import Constraint, Goal
 
 __all__ = ["goal_from_observation"]
 
@@ -29,21 +29,30 @@ def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: Featu
     start : (k, d) array
         The start scene as perceived.
     """
-    seen = observed[observed[:, 0] >= 0.5] if observed.size else observed.reshape(0, len(schema))
+    needed = ("x_min", "x_max", "y_min", "y_max", "z_min")
+    if schema.visibility_index is None or any(n not in schema.names for n in needed):
+        raise ValueError("emulation is chapter 8's: it needs entities that can vanish and have x, y and z extents, "
+                         "which this model's features do not have")
+    seen = observed[schema.visible(observed)] if observed.size else observed.reshape(0, len(schema))
     k = start.shape[0]
-    vis = schema.index("visibility")
+    vis = schema.visibility_index
+    vis_ch = schema.channel(schema.channels[vis])
+    pos = schema.channel(schema.channels[schema.index("x_min")])
+
+    def c(obj, n, value, tol):
+        j = schema.index(n)
+        return Constraint(obj, j, n, value, tol, schema.channels[j], pos.scale)
+
     if seen.shape[0] == 0:  # visibility first: nothing shown, so nothing should be seen
-        return Goal(tuple(Constraint(i, vis, "visibility", 0.0, DEFAULT_TOLERANCE["visibility"], "visibility")
+        return Goal(tuple(Constraint(i, vis, schema.visibility, 0.0, vis_ch.tolerance, schema.channels[vis], vis_ch.scale)
                           for i in range(k)))
     if seen.shape[0] == 1:  # one object shown: an object should be where it is
         # Its footprint on the table plane, loosely (pushes move objects in steps of a
         # decimetre or more, and the start object need not have the shown one's size), and
         # the height of its bottom (lifted or not); its top depends on the object's size.
         f = seen[0]
-        out = [Constraint("*", schema.index(n), n, float(f[schema.index(n)]), 2 * tolerance, "position")
-               for n in ("x_min", "x_max", "y_min", "y_max")]
-        z = schema.index("z_min")
-        out.append(Constraint("*", z, "z_min", float(f[z]), 1.5 * tolerance, "position"))
+        out = [c("*", n, float(f[schema.index(n)]), 2 * tolerance) for n in ("x_min", "x_max", "y_min", "y_max")]
+        out.append(c("*", "z_min", float(f[schema.index("z_min")]), 1.5 * tolerance))
         return Goal(tuple(out))
     if k < 2:
         raise ValueError("the shown scene relates two objects, but the start scene has fewer than two")
@@ -52,5 +61,5 @@ def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: Featu
     out = []
     for n in ("x_min", "x_max", "y_min", "y_max"):
         j = schema.index(n)
-        out.append(Constraint((0, 1), j, n, float(a[j] - b[j]), 2 * tolerance, "position"))
+        out.append(c((0, 1), n, float(a[j] - b[j]), 2 * tolerance))
     return Goal(tuple(out))

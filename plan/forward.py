@@ -18,7 +18,13 @@ from itertools import product
 
 import numpy as np
 
-__all__ = ["BehaviorModel", "ForwardModel", "Outcome"]
+from features import encode_parameters
+
+__all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE"]
+
+
+#: The object index a step on a behaviour without a target carries: it acts on the scene.
+SCENE = -1
 
 
 @dataclass
@@ -27,22 +33,26 @@ class BehaviorModel:
 
     name: str
     predictor: object                  # predict_proba, classes_
-    selected: np.ndarray               # object-feature columns the predictor reads
-    prototypes: np.ndarray             # (n_categories, d) mean effects
+    selected: np.ndarray               # entity-feature columns the predictor reads
+    prototypes: np.ndarray | None      # (n_categories, d) mean effects; None: labels given, no effects
     parameters: list[tuple[float, float]] = field(default_factory=list)  # alpha ranges
     known: object | None = None        # P(the effect is of a kept kind): predict_proba, classes_ [0, 1]
     known_selected: np.ndarray | None = None  # the columns ``known`` reads (None: ``selected``)
+    periodic: tuple[bool, ...] = ()    # which parameters are angles (encoded as sine and cosine)
+    target: str | None = "object"      # None: the behaviour acts on no one object; every row may change
 
 
 @dataclass(frozen=True)
 class Outcome:
-    category: int
+    category: int | tuple
     probability: float
     state: np.ndarray
 
 
 def _as_slice(index: np.ndarray):
     """``index`` as a slice when it is a run of consecutive integers, else unchanged."""
+    if isinstance(index, slice):
+        return index
     if index.ndim == 1 and index.size and index.dtype.kind in "iu" and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
         return slice(int(index[0]), int(index[0]) + index.size)
     return index
@@ -54,28 +64,34 @@ class ForwardModel:
     Parameters
     ----------
     behaviors : list of BehaviorModel
+    schema : FeatureSchema
+        What the entity features mean: the visibility feature (none: always visible), the
+        histograms (after adding a prototype they are clipped at 0 and renormalised, so a
+        predicted entity stays one the predictors could have seen) and the ``height`` role
+        (with it the planner knows when a step leaves an object in the hand,
+        :meth:`in_hand`).
     min_probability : float
         Outcomes less likely than this are not expanded by the search.
     param_steps : int
         Grid points per parameter of a parametric behaviour (chapter 9).
-    height : int or None
-        Index of the object's bottom height (``z_min``): with it the planner knows when a
-        step leaves an object in the hand (:meth:`in_hand`).
     raised : float
-        Rise (metres) that means an object is held.
-    histograms : list of index arrays, optional
-        Feature columns that form a normalised histogram (the shape channel's two): after
-        adding a prototype they are clipped at 0 and renormalised, so that a predicted
-        object stays an object the predictors could have seen.
+        Rise (metres) of the height feature that means an object is held.
+    height : int or None
+        Overrides the schema's ``height`` role.
+
+    A behaviour whose ``target`` is None acts on the whole scene: every visible row changes
+    by its own predicted effect, and an outcome is one category per row (its probability
+    the product of theirs, rows taken as independent given their features).
     """
 
-    def __init__(self, behaviors: list[BehaviorModel], min_probability: float = 0.02, param_steps: int = 5,
-                 histograms: list[np.ndarray] | None = None, height: int | None = None, raised: float = 0.05):
+    def __init__(self, behaviors: list[BehaviorModel], schema, min_probability: float = 0.02,
+                 param_steps: int = 5, raised: float = 0.05, height: int | None = None):
         self.behaviors = behaviors
-        self.height = height
+        self.schema = schema
+        self.visibility = schema.visibility_index
+        self.height = height if height is not None else schema.role("height")
         self.raised = raised
-        # contiguous index runs become slices (much cheaper to index with, per node)
-        self.histograms = [_as_slice(np.asarray(h)) for h in (histograms or [])]
+        self.histograms = [_as_slice(h) for h in schema.histogram_slices]
         self.names = [b.name for b in behaviors]
         self.min_probability = min_probability
         self.param_steps = param_steps
@@ -89,6 +105,15 @@ class ForwardModel:
         except ValueError:
             raise ValueError(f"unknown behaviour {name!r}; the model knows {', '.join(self.names)}") from None
 
+    @property
+    def predicts_effects(self) -> bool:
+        """Do all behaviours have effect prototypes (labels discovered, not given)?"""
+        return all(b.prototypes is not None for b in self.behaviors)
+
+    def visible(self, f: np.ndarray) -> bool:
+        """Is the entity (row) seen? Always, for a schema without a visibility feature."""
+        return self.visibility is None or bool(f[self.visibility] >= 0.5)
+
     def alphas(self, b: int) -> list[tuple[float, ...]]:
         """The parameter grid of behaviour ``b`` (one empty tuple for a behaviour without)."""
         ranges = self.behaviors[b].parameters
@@ -98,7 +123,7 @@ class ForwardModel:
         return [tuple(float(v) for v in p) for p in product(*axes)]
 
     def distribution(self, f: np.ndarray, b: int, alpha: tuple = ()) -> tuple[np.ndarray, np.ndarray]:
-        """(categories, probabilities) of behaviour ``b`` on object vector ``f``."""
+        """(categories, probabilities) of behaviour ``b`` on entity vector ``f``."""
         key = (b, f.tobytes(), alpha)
         if key not in self._cache:
             self.prefetch([f], b, alpha)
@@ -115,16 +140,20 @@ class ForwardModel:
         return self._fast[key]
 
     def cached(self, f: np.ndarray) -> bool:
-        """Are every behaviour's predictions for object vector ``f`` at hand?"""
+        """Are every behaviour's predictions for entity vector ``f`` at hand?"""
         key = f.tobytes()
         return all((b, key, a) in self._cache for b in range(len(self.behaviors)) for a in self.alphas(b))
 
-    def prefetch(self, vectors: list[np.ndarray], only: int | None = None, alpha_only: tuple | None = None) -> None:
-        """Predict for many object vectors at once (one call per behaviour and alpha).
+    def _alpha_columns(self, model: BehaviorModel, alpha: tuple) -> np.ndarray:
+        specs = [{"periodic": bool(model.periodic[j]) if j < len(model.periodic) else False} for j in range(len(alpha))]
+        return encode_parameters(np.asarray(alpha, dtype=float), specs) if alpha else np.zeros(0)
 
-        A search needs each new object vector's predictions when it expands that state;
-        asking the predictors for all of a node's children in one batch costs little more
-        than asking for one (scikit-learn's per-call overhead dominates single rows).
+    def prefetch(self, vectors: list[np.ndarray], only: int | None = None, alpha_only: tuple | None = None) -> None:
+        """Predict for many entity vectors at once (one call per behaviour and alpha).
+
+        A search needs each new vector's predictions when it expands that state; asking the
+        predictors for all of a node's children in one batch costs little more than asking
+        for one (scikit-learn's per-call overhead dominates single rows).
         """
         fresh = {v.tobytes(): v for v in vectors}
         for b, model in enumerate(self.behaviors):
@@ -134,12 +163,13 @@ class ForwardModel:
                 todo = [v for key, v in fresh.items() if (b, key, alpha) not in self._cache]
                 if not todo:
                     continue
-                X = np.stack([np.concatenate([v[model.selected], np.asarray(alpha, dtype=float)]) for v in todo])
+                a = self._alpha_columns(model, alpha)
+                X = np.stack([np.concatenate([v[model.selected], a]) for v in todo])
                 proba = self._proba(model.predictor)(X)
                 if model.known is not None:
                     # the chance that the effect is one of the kinds the categories kept
                     Xk = X if model.known_selected is None else np.stack(
-                        [np.concatenate([v[model.known_selected], np.asarray(alpha, dtype=float)]) for v in todo])
+                        [np.concatenate([v[model.known_selected], a]) for v in todo])
                     kept = self._proba(model.known)(Xk)[:, list(model.known.classes_).index(1)]
                     proba = proba * kept[:, None]
                 classes = np.asarray(model.predictor.classes_, dtype=int)
@@ -148,54 +178,78 @@ class ForwardModel:
                 self.predictions += len(todo)
 
     def in_hand(self, before: np.ndarray, after: np.ndarray, obj: int) -> bool:
-        """Did acting on ``obj`` leave it in the hand? It rose by more than ``raised``.
+        """Did acting on ``obj`` leave it in the hand? Its height feature rose by more than ``raised``.
 
         Only a grasp raises an object, and the hand keeps what it raised until its next
         behaviour, which first opens it (sim.behaviors). A robot knows what its own hand
-        did; here it reads it off the object's bottom height, perceived or predicted.
+        did; here it reads it off the object's height, perceived or predicted.
         """
-        if self.height is None or after[obj, 0] < 0.5:
+        if self.height is None or obj < 0 or not self.visible(after[obj]):
             return False
         return bool(after[obj, self.height] - before[obj, self.height] > self.raised)
 
-    def apply(self, state: np.ndarray, obj: int, b: int, category: int) -> np.ndarray:
-        """The state after behaviour ``b`` on ``obj`` produced ``category``."""
+    def _moved(self, before: np.ndarray, b: int, category: int) -> np.ndarray:
+        """Entity ``before`` after category ``category`` of behaviour ``b`` (vanished: last seen, visibility 0)."""
+        prototypes = self.behaviors[b].prototypes
+        if prototypes is None:
+            raise ValueError(f"behaviour {self.names[b]!r} has no effect prototypes (its labels were given), "
+                             "so the next state cannot be predicted")
+        f = before + prototypes[category]
+        v = self.visibility
+        if v is not None and f[v] < 0.5:
+            out = before.copy()
+            out[v] = 0.0
+            return out
+        if v is not None:
+            f[v] = 1.0
+        for h in self.histograms:  # a predicted histogram is still a histogram
+            bins = np.maximum(f[h], 0.0)
+            total = bins.sum()
+            f[h] = bins / total if total > 0 else before[h]
+        return f
+
+    def apply(self, state: np.ndarray, obj: int, b: int, category) -> np.ndarray:
+        """The state after behaviour ``b`` on ``obj`` produced ``category``.
+
+        For a behaviour without a target (``obj`` is :data:`SCENE`), ``category`` holds one
+        category per row (None for a row left as it is: an unseen one).
+        """
         nxt = state.copy()
-        f = state[obj] + self.behaviors[b].prototypes[category]
-        if f[0] < 0.5:  # vanished: the last seen features stay, visibility drops
-            nxt[obj, 0] = 0.0
-        else:
-            f[0] = 1.0
-            for h in self.histograms:  # a predicted histogram is still a histogram
-                bins = np.maximum(f[h], 0.0)
-                total = bins.sum()
-                f[h] = bins / total if total > 0 else state[obj, h]
-            nxt[obj] = f
+        if obj == SCENE:
+            for i, c in enumerate(category):
+                if c is not None:
+                    nxt[i] = self._moved(state[i], b, int(c))
+            return nxt
+        nxt[obj] = self._moved(state[obj], b, int(category))
         return nxt
 
-    def outcomes(self, state: np.ndarray, obj: int, b: int, alpha: tuple = ()) -> list[Outcome]:
-        """Likely outcomes (probability >= min_probability), most likely first."""
-        if state[obj, 0] < 0.5:
+    def outcomes(self, state: np.ndarray, obj: int, b: int, alpha: tuple = (), floor: float | None = None) -> list[Outcome]:
+        """Likely outcomes (probability >= ``floor``, by default min_probability), most likely first."""
+        floor = self.min_probability if floor is None else floor
+        if obj == SCENE:
+            return self._scene_outcomes(state, b, alpha, floor)
+        if not self.visible(state[obj]):
             return []  # the robot cannot act on what it does not see
         classes, proba = self.distribution(state[obj], b, alpha)
         order = np.argsort(-proba, kind="stable")
         return [Outcome(int(classes[i]), float(proba[i]), self.apply(state, obj, b, int(classes[i])))
-                for i in order if proba[i] >= self.min_probability]
+                for i in order if proba[i] >= floor]
 
-    def choose_alpha(self, f: np.ndarray, b: int, rule: str = "probable") -> tuple[tuple, int]:
-        """Chapter 9's parameter choice for one behaviour on one object.
-
-        ``"group"``: predict a category for every grid point, take the largest group of
-        points predicting the same category, and return the mean of its alphas.
-        ``"probable"``: the grid point whose predicted category is most probable.
-        """
-        grid = self.alphas(b)
-        preds = [self.distribution(f, b, a) for a in grid]
-        best = [(int(c[np.argmax(p)]), float(p.max())) for c, p in preds]
-        if rule == "group":
-            cats = [c for c, _ in best]
-            top = max(set(cats), key=lambda c: (cats.count(c), -c))
-            members = np.array([a for a, c in zip(grid, cats) if c == top])
-            return tuple(float(v) for v in members.mean(axis=0)) if members.size else (), top
-        i = int(np.argmax([p for _, p in best]))
-        return grid[i], best[i][0]
+    def _scene_outcomes(self, state: np.ndarray, b: int, alpha: tuple, floor: float) -> list[Outcome]:
+        """Joint outcomes of a behaviour that changes every visible row by its own effect."""
+        rows = [i for i in range(state.shape[0]) if self.visible(state[i])]
+        choices = []
+        for i in rows:
+            classes, proba = self.distribution(state[i], b, alpha)
+            choices.append([(int(c), float(p)) for c, p in zip(classes, proba) if p >= floor] or [(None, 1.0)])
+        out = []
+        for combo in product(*choices):
+            p = float(np.prod([q for _, q in combo]))
+            if p < floor:
+                continue
+            cats: list = [None] * state.shape[0]
+            for i, (c, _) in zip(rows, combo):
+                cats[i] = c
+            out.append(Outcome(tuple(cats), p, self.apply(state, SCENE, b, cats)))
+        out.sort(key=lambda o: -o.probability)
+        return out

@@ -1,9 +1,11 @@
 """Goals: constraints on perceived features (thesis chapter 8.6's {(o, i_f, v, r)}).
 
 An expression ``OBJ:FEATURE=VALUE~RANGE`` says: feature FEATURE of object OBJ must lie
-within RANGE of VALUE. OBJ is an object index, ``*`` (some object) or ``A-B`` (object A's
-feature minus object B's: a relative goal). Without ``~RANGE`` a default tolerance for the
-feature's channel applies. Several constraints must all hold.
+within RANGE of VALUE; ``OBJ:FEATURE<VALUE`` and ``OBJ:FEATURE>VALUE`` that it must lie
+below or above VALUE. OBJ is an object index, ``*`` (some object) or ``A-B`` (object A's
+feature minus object B's: a relative goal). Without ``~RANGE`` the default tolerance of
+the feature's channel applies, as the schema gives it; so does the scale the search's
+heuristic measures the channel in. Several constraints must all hold.
 """
 
 from __future__ import annotations
@@ -16,14 +18,9 @@ import numpy as np
 
 from features import FeatureSchema
 
-__all__ = ["Constraint", "Goal", "parse_goal", "DEFAULT_TOLERANCE", "GoalError"]
+__all__ = ["Constraint", "Goal", "parse_goal", "GoalError"]
 
-#: Default tolerance per channel, used where an expression gives no ``~RANGE``.
-DEFAULT_TOLERANCE = {"visibility": 0.5, "position": 0.05, "shape": 0.1}
-#: How far one unit of each channel counts in the search heuristic.
-SCALE = {"visibility": 1.0, "position": 0.1, "shape": 0.5}
-
-_EXPR = re.compile(r"^\s*(?P<obj>\*|\d+|\d+\s*-\s*\d+)\s*:\s*(?P<feat>[A-Za-z_][\w]*)\s*=\s*(?P<val>[-+]?(?:[\d.eE+-]+|nan|inf))"
+_EXPR = re.compile(r"^\s*(?P<obj>\*|\d+|\d+\s*-\s*\d+)\s*:\s*(?P<feat>[A-Za-z_][\w]*)\s*(?P<op>[=<>])\s*(?P<val>[-+]?(?:[\d.eE+-]+|nan|inf))"
                    r"\s*(~\s*(?P<rng>[-+]?(?:[\d.eE+-]+|nan|inf)))?\s*$", re.IGNORECASE)
 
 
@@ -41,9 +38,13 @@ class Constraint:
     value: float
     tolerance: float
     channel: str
+    scale: float = 1.0   # how far one unit of the channel counts in the search heuristic
+    op: str = "="        # "=" within tolerance, "<" below value, ">" above value
 
     def text(self) -> str:
         obj = f"{self.obj[0]}-{self.obj[1]}" if isinstance(self.obj, tuple) else str(self.obj)
+        if self.op != "=":
+            return f"{obj}:{self.name}{self.op}{self.value:g}"
         return f"{obj}:{self.name}={self.value:g}~{self.tolerance:g}"
 
 
@@ -69,7 +70,8 @@ class Goal:
             "any": (np.array(any_, int), take(any_, lambda c: c.feature).astype(int)),
             "value": np.array([c.value for c in self.constraints], float),
             "tolerance": np.array([c.tolerance for c in self.constraints], float),
-            "scale": np.array([SCALE.get(c.channel, 1.0) for c in self.constraints], float),
+            "scale": np.array([c.scale for c in self.constraints], float),
+            "sign": np.array([{"=": 0.0, "<": 1.0, ">": -1.0}[c.op] for c in self.constraints], float),
             "named": [c.obj if isinstance(c.obj, int) else None for c in self.constraints],
             "pairs": [c.obj if isinstance(c.obj, tuple) else None for c in self.constraints],
         }
@@ -82,15 +84,24 @@ class Goal:
         v[pos] = state[obj, feat]
         pos, i, j, feat = a["pair"]
         v[pos] = state[i, feat] - state[j, feat]
-        gaps = np.maximum(np.abs(v - a["value"]) - a["tolerance"], 0.0)
+        gaps = self._gap(v, a["value"], a["tolerance"], a["sign"])
         pos, feat = a["any"]
         if pos.size:
             if state.shape[0] == 0:
                 gaps[pos] = np.inf
             else:
-                cand = np.maximum(np.abs(state[:, feat] - a["value"][pos]) - a["tolerance"][pos], 0.0)
+                cand = self._gap(state[:, feat], a["value"][pos], a["tolerance"][pos], a["sign"][pos])
                 gaps[pos] = cand.min(axis=0)
         return gaps
+
+    @staticmethod
+    def _gap(v, value, tolerance, sign):
+        """0 where a constraint holds, else how far it is from holding."""
+        within = np.maximum(np.abs(v - value) - tolerance, 0.0)
+        if not sign.any():
+            return within
+        beyond = np.maximum(sign * (v - value), 0.0)  # "<": above the value by; ">": below it by
+        return np.where(sign == 0.0, within, beyond)
 
     def holds(self, state: np.ndarray, gaps: np.ndarray | None = None) -> bool:
         g = self.gaps(state) if gaps is None else gaps
@@ -145,7 +156,8 @@ def parse_goal(expressions: list[str], schema: FeatureSchema) -> Goal:
     for expr in expressions:
         m = _EXPR.match(expr)
         if not m:
-            raise GoalError(f"cannot read goal {expr!r}; write OBJ:FEATURE=VALUE~RANGE, e.g. '0:z_min=0.95~0.03'")
+            raise GoalError(f"cannot read goal {expr!r}; write OBJ:FEATURE=VALUE~RANGE, OBJ:FEATURE<VALUE or "
+                            f"OBJ:FEATURE>VALUE, e.g. '0:z_min=0.95~0.03'")
         try:
             feature = schema.index(m["feat"])
         except KeyError:
@@ -167,8 +179,11 @@ def parse_goal(expressions: list[str], schema: FeatureSchema) -> Goal:
         except ValueError:
             raise GoalError(f"goal {expr!r} has a value that is not a number") from None
         channel = schema.channels[feature]
-        tol = DEFAULT_TOLERANCE.get(channel, 0.05) if tol is None else tol
+        info = schema.channel(channel)
+        if m["op"] != "=" and tol is not None:
+            raise GoalError(f"goal {expr!r}: a range (~) goes with '=', not with '{m['op']}'")
+        tol = info.tolerance if tol is None else tol
         if not (np.isfinite(tol) and np.isfinite(value)) or tol < 0:
             raise GoalError(f"goal {expr!r}: the value must be finite and the range not negative")
-        out.append(Constraint(obj, feature, schema.names[feature], value, tol, channel))
+        out.append(Constraint(obj, feature, schema.names[feature], value, tol, channel, info.scale, m["op"]))
     return Goal(tuple(out))

@@ -25,8 +25,9 @@ from typing import Callable, Protocol
 import numpy as np
 
 from plan.forward import ForwardModel
-from plan.goals import DEFAULT_TOLERANCE, Goal
-from plan.search import UNREACHABLE, Plan, best_plans, search
+from plan.forward import SCENE
+from plan.goals import Goal
+from plan.search import UNREACHABLE, Plan, best_plans, search, situation
 
 __all__ = ["World", "Execution", "assess", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
 
@@ -59,21 +60,39 @@ class Execution:
                 "executed": self.executed, "plans": [p.to_json() for p in self.plans]}
 
 
-def mismatch(goal: Goal, predicted: np.ndarray, perceived: np.ndarray, position_slack: float = 0.08) -> str:
-    """Why the perceived state differs from the predicted one on the goal's channels ('' if not)."""
+def mismatch(goal: Goal, predicted: np.ndarray, perceived: np.ndarray, schema, slack: float = 1.6) -> str:
+    """Why the perceived state differs from the predicted one on the goal's channels ('' if not).
+
+    The schema says what to compare: visibility (seen or gone), then each constrained
+    channel's features, allowed ``slack`` times their goal tolerance for measurements
+    (8 cm of the table's positions) and twice it for histogram bins.
+    """
     channels = goal.channels
+    vis = schema.visibility_index
+    vis_channel = None if vis is None else schema.channels[vis]
+    measured = {ch: idx for ch, idx in schema.channel_groups()}
+    # a flip of visibility matters to goals on visibility or on measurements (not on histograms alone)
+    flips = vis is not None and (vis_channel in channels or any(
+        not schema.in_histogram[measured[ch]].all() for ch in channels if ch in measured and ch != vis_channel))
+    seen_p, seen_q = schema.visible(predicted), schema.visible(perceived)
     for i in range(min(predicted.shape[0], perceived.shape[0])):
-        if "visibility" in channels or "position" in channels:
-            if (predicted[i, 0] >= 0.5) != (perceived[i, 0] >= 0.5):
-                return f"object {i} is {'gone' if perceived[i, 0] < 0.5 else 'still there'}, unlike predicted"
-        if "position" in channels and perceived[i, 0] >= 0.5:
-            gap = float(np.abs(predicted[i, 1:7] - perceived[i, 1:7]).max())
-            if gap > position_slack:
-                return f"object {i} ended {gap:.2f} m from where it was predicted"
-        if "shape" in channels and perceived[i, 0] >= 0.5:
-            gap = float(np.abs(predicted[i, 7:] - perceived[i, 7:]).max())
-            if gap > 2 * DEFAULT_TOLERANCE["shape"]:
-                return f"object {i} looks different from predicted"
+        if flips:
+            if seen_p[i] != seen_q[i]:
+                return f"object {i} is {'gone' if not seen_q[i] else 'still there'}, unlike predicted"
+        if not seen_q[i]:
+            continue
+        for ch in sorted(channels):
+            idx = measured.get(ch)
+            if idx is None or ch == vis_channel:
+                continue
+            in_hist = schema.in_histogram[idx]
+            tol = schema.channel(ch).tolerance * np.where(in_hist, 2.0, slack)
+            gap = np.abs(predicted[i, idx] - perceived[i, idx])
+            if (gap > tol).any():
+                if in_hist.all():
+                    return f"object {i} looks different from predicted"
+                unit = schema.channel(ch).unit
+                return f"object {i} ended {float(gap.max()):.2f}{(' ' + unit) if unit else ''} from where it was predicted"
     return ""
 
 
@@ -108,7 +127,7 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
         surprised, windfall = "", False
         for step in plan.steps:
             previous, was_held = state, held == step.obj
-            before = state[step.obj].copy()
+            before = situation(model, state, step.obj)
             state = world.act(step.behavior, step.obj, np.asarray(step.alpha, dtype=float))
             held = step.obj if model.in_hand(previous, state, step.obj) else -1
             if not getattr(world, "last_executed", True):
@@ -117,7 +136,7 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
                 surprised = out_of_reach = f"the arm cannot reach object {step.obj} where it lies"
                 failed.append((before, UNREACHABLE, step.obj, was_held))
             else:
-                surprised = mismatch(goal, step.predicted, state)
+                surprised = mismatch(goal, step.predicted, state, model.schema)
                 if surprised:
                     failed.append((before, step.behavior, step.obj, was_held))
             run.executed.append({**step.to_json(), "as_predicted": not surprised, "note": surprised})
@@ -162,18 +181,27 @@ class _Imagined:
     def perceive(self) -> np.ndarray:
         return self.state.copy()
 
-    def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:
-        b = self.model.index(behavior)
-        alpha_key = tuple(float(a) for a in (() if alpha is None else alpha))
-        key = (self.state[target].tobytes(), b, alpha_key)
+    def _fate(self, f: np.ndarray, b: int, alpha: tuple):
+        """The category this world holds for behaviour ``b`` on entity ``f`` (None: unknown kind)."""
+        key = (f.tobytes(), b, alpha)
         if key not in self.fate:
-            classes, proba = self.model.distribution(self.state[target], b, alpha_key)
+            classes, proba = self.model.distribution(f, b, alpha)
             edges = np.cumsum(proba)
             r = self.rng.random()
             self.fate[key] = int(classes[min(np.searchsorted(edges, r, side="right"), len(classes) - 1)]) \
                 if edges.size and r < edges[-1] else None
-        if self.fate[key] is not None and self.state[target, 0] >= 0.5:
-            self.state = self.model.apply(self.state, target, b, self.fate[key])
+        return self.fate[key]
+
+    def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:
+        b = self.model.index(behavior)
+        alpha_key = tuple(float(a) for a in (() if alpha is None else alpha))
+        if target == SCENE:  # every seen row meets its own fate
+            cats = [self._fate(f, b, alpha_key) if self.model.visible(f) else None for f in self.state]
+            self.state = self.model.apply(self.state, SCENE, b, cats)
+            return self.perceive()
+        fate = self._fate(self.state[target], b, alpha_key)
+        if fate is not None and self.model.visible(self.state[target]):
+            self.state = self.model.apply(self.state, target, b, fate)
         return self.perceive()
 
 

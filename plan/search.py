@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from plan.forward import ForwardModel
+from plan.forward import SCENE, ForwardModel
 from plan.goals import Goal
 
 __all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE", "UNREACHABLE"]
@@ -87,13 +87,36 @@ UNREACHABLE = "*"
 DISTRUST = math.log(2.0)
 
 
-def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int, held: int = -1) -> float:
+def situation(model: ForwardModel, state: np.ndarray, obj: int) -> np.ndarray:
+    """What says where an entity is: its geometry features (every row's, for a step on the scene)."""
+    cols = _geometry(model)
+    return state[:, cols].ravel() if obj == SCENE else state[obj, cols]
+
+
+def _geometry(model: ForwardModel) -> np.ndarray:
+    return model.schema.geometry
+
+
+def _same_place(model: ForwardModel, f: np.ndarray, g: np.ndarray) -> bool:
+    """Two situations closer than their features' goal tolerance (SAME_PLACE for the table's
+    positions) are the same."""
+    if f.shape != g.shape:
+        return False
+    tol = model.schema.tolerances[_geometry(model)]
+    if f.size != tol.size:  # a step on the scene: every row's geometry
+        tol = np.resize(tol, f.size)
+    return bool((np.abs(f - g) < tol).all())
+
+
+def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int, held: int = -1,
+              model: ForwardModel | None = None) -> float:
     """Extra search cost of ``behavior`` on ``obj`` after it surprised the robot.
 
-    ``avoid`` holds (object features before, behaviour, object, whether the hand held it)
+    ``avoid`` holds (entity situation before, behaviour, object, whether the hand held it)
     of steps whose outcome surprised the robot during execution. Each such surprise costs
-    2 * DISTRUST where the object is in the same situation again (within SAME_PLACE) and
-    DISTRUST elsewhere: the model erred there, and would predict the same again.
+    2 * DISTRUST where the object is in the same situation again (its geometry features
+    within their goal tolerance: SAME_PLACE for the table's positions) and DISTRUST
+    elsewhere: the model erred there, and would predict the same again.
 
     The hand splits situations in two. A surprise on an object the hand held says nothing
     about the same behaviour on that object lying on the table (the model sees another
@@ -107,35 +130,41 @@ def _distrust(avoid: tuple, state: np.ndarray, behavior: str, obj: int, held: in
     object lay beyond its reach: every behaviour on that object in the same situation
     costs ``inf`` (the search leaves it out).
     """
-    f = state[obj, 1:7]
+    f = situation(model, state, obj)
     now_held = held == obj
     cost = 0.0
     for g, b, i, in_hand in avoid:
         if i != obj or in_hand != now_held:
             continue
+        same = _same_place(model, f, g)
         if b == UNREACHABLE:
-            if np.abs(f - g[1:7]).max() < SAME_PLACE:
+            if same:
                 return math.inf  # the arm did not start there: it cannot, whatever it does
             continue
         if b == behavior:
-            cost += 2 * DISTRUST if np.abs(f - g[1:7]).max() < SAME_PLACE else DISTRUST
+            cost += 2 * DISTRUST if same else DISTRUST
         elif in_hand:
             cost += DISTRUST
     return cost
 
 
-#: An outcome that moves no feature of the object more than this is no change at all.
-NO_OP = 0.005
+#: An outcome that moves no feature of the object more than this share of its goal
+#: tolerance (half a centimetre of the table's positions) is no change at all.
+NO_OP = 0.1
 
 
-def _no_op(before: np.ndarray, after: np.ndarray, obj: int) -> bool:
-    """Neither visibility nor position moved (shape histograms jitter with the view)."""
-    return bool(np.abs(after[obj, :7] - before[obj, :7]).max() < NO_OP)
+def _no_op(model: ForwardModel, before: np.ndarray, after: np.ndarray, obj: int) -> bool:
+    """Neither visibility nor geometry moved (histograms jitter with the view)."""
+    schema = model.schema
+    cols = schema.geometry if schema.visibility_index is None else np.append(schema.geometry, schema.visibility_index)
+    rows = slice(None) if obj == SCENE else obj
+    return bool((np.abs(after[rows][..., cols] - before[rows][..., cols]) < NO_OP * schema.tolerances[cols]).all())
 
 
 def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None, held: int = -1):
     """(behaviour, object, alpha) to try. A behaviour changes only its own object (chapter
-    8), so when the goal names its objects (no ``*``) acting on any other cannot help.
+    8), so when the goal names its objects (no ``*``) acting on any other cannot help. A
+    behaviour without a target acts on the scene (object :data:`plan.forward.SCENE`).
 
     While the hand holds object ``held``, and the goal may be about it, only that object
     is acted on: a behaviour on another one would first open the hand and drop it, an
@@ -143,10 +172,16 @@ def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None, h
     foresee."""
     named = goal.objects() if goal is not None and all(c.obj != "*" for c in goal.constraints) else None
     only = held if held >= 0 and (named is None or held in named) else None
+    for b, behavior in enumerate(model.behaviors):
+        if behavior.target is None:
+            for alpha in model.alphas(b):
+                yield b, SCENE, alpha
     for obj in range(state.shape[0]):
-        if state[obj, 0] < 0.5 or (named is not None and obj not in named) or (only is not None and obj != only):
+        if not model.visible(state[obj]) or (named is not None and obj not in named) or (only is not None and obj != only):
             continue
-        for b in range(len(model.behaviors)):
+        for b, behavior in enumerate(model.behaviors):
+            if behavior.target is None:
+                continue
             for alpha in model.alphas(b):
                 yield b, obj, alpha
 
@@ -211,16 +246,16 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
         # Predictions wait until a node needs them, then come for every vector met so far
         # in one batch per behaviour: scikit-learn's per-call overhead, not the rows, is
         # what a planning search pays for.
-        if any(not model.cached(state[i]) for i in range(state.shape[0]) if state[i, 0] >= 0.5):
+        if any(not model.cached(state[i]) for i in range(state.shape[0]) if model.visible(state[i])):
             model.prefetch(pending + [state[i] for i in range(state.shape[0])])
             pending = []
         for b, obj, alpha in _actions(model, state, goal, held):
-            penalty = _distrust(avoid, state, model.names[b], obj, held) if avoid else 0.0
+            penalty = _distrust(avoid, state, model.names[b], obj, held, model) if avoid else 0.0
             if penalty == math.inf:
                 continue
             for out in model.outcomes(state, obj, b, alpha):
                 generated += 1
-                if _no_op(state, out.state, obj):
+                if _no_op(model, state, out.state, obj):
                     continue  # an outcome that changes nothing cannot be part of a shortest way
                 gaps = goal.gaps(out.state)
                 if len(steps) + 1 + goal.min_steps(out.state, gaps) > max_depth:
@@ -244,7 +279,7 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
                 heapq.heappush(frontier, (c + heuristic_weight * h, h, counter, c, out.state, steps + (step,),
                                           reached, now_held))
                 if len(steps) + 1 < max_depth:
-                    pending.append(out.state[obj])
+                    pending.extend(out.state if obj == SCENE else [out.state[obj]])
     return found or [Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                           f"no plan of at most {max_depth} steps reaches the goal", tree)]
 
@@ -266,14 +301,14 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
             for b, obj, alpha in _actions(model, state, goal, held):
-                if avoid and _distrust(avoid, state, model.names[b], obj, held) >= 2 * DISTRUST:
+                if avoid and _distrust(avoid, state, model.names[b], obj, held, model) >= 2 * DISTRUST:
                     continue  # chaining has no costs: a step that failed here is simply not retried
                 outs = model.outcomes(state, obj, b, alpha)
                 if not outs:
                     continue
                 out = outs[0]
                 generated += 1
-                if _no_op(state, out.state, obj) or len(steps) + 1 + goal.min_steps(out.state) > max_depth:
+                if _no_op(model, state, out.state, obj) or len(steps) + 1 + goal.min_steps(out.state) > max_depth:
                     continue
                 now_held = obj if model.in_hand(state, out.state, obj) else -1
                 k = _key(out.state, now_held)
@@ -302,15 +337,7 @@ def success_probability(model: ForwardModel, start: np.ndarray, goal: Goal, step
             return 0.0
         s = steps[i]
         b = model.index(s.behavior)
-        if state[s.obj, 0] < 0.5:
-            return 0.0
-        classes, proba = model.distribution(state[s.obj], b, s.alpha)
-        total = 0.0
-        for c, p in zip(classes, proba):
-            if p < 1e-4:
-                continue
-            total += p * walk(model.apply(state, s.obj, b, int(c)), i + 1)
-        return total
+        return sum(o.probability * walk(o.state, i + 1) for o in model.outcomes(state, s.obj, b, s.alpha, floor=1e-4))
 
     return float(min(1.0, walk(start, 0)))
 
@@ -330,8 +357,7 @@ def inverse_query(model: ForwardModel, state: np.ndarray, goal: Goal) -> list[di
     """
     ranked = []
     for b, obj, alpha in _actions(model, state):
-        classes, proba = model.distribution(state[obj], b, alpha)
-        p = sum(float(pr) for c, pr in zip(classes, proba) if goal.holds(model.apply(state, obj, b, int(c))))
+        p = sum(o.probability for o in model.outcomes(state, obj, b, alpha, floor=0.0) if goal.holds(o.state))
         ranked.append({"object": obj, "behavior": model.names[b], "alpha": list(alpha), "probability": round(p, 4)})
     ranked.sort(key=lambda r: (-r["probability"], r["object"], r["behavior"]))
     return ranked

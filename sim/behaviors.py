@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from features.objects import extents
+
 if TYPE_CHECKING:
     from sim.world import TableWorld
 
@@ -40,38 +42,57 @@ __all__ = ["Parameter", "Behavior", "Execution", "TABLE_BEHAVIORS"]
 
 @dataclass(frozen=True)
 class Parameter:
-    """One behaviour parameter: a name, its range and unit."""
+    """One behaviour parameter: a name, its range and unit.
+
+    ``periodic``: an angle whose ends meet (0 and 360 degrees are one direction); learners
+    see it as its sine and cosine (``features.encode_parameters``).
+    """
 
     name: str
     low: float
     high: float
     unit: str = ""
+    periodic: bool = False
 
     def to_json(self) -> dict:
-        return {"name": self.name, "low": self.low, "high": self.high, "unit": self.unit}
+        return {"name": self.name, "low": self.low, "high": self.high, "unit": self.unit, "periodic": self.periodic}
 
 
 @dataclass(frozen=True)
 class Execution:
-    """What the robot knows about its own execution (not ground truth of the object)."""
+    """What the robot knows about its own execution (not ground truth of the world)."""
 
-    executed: bool   # the approach point was within reach and the hand moved
+    executed: bool                 # the robot carried the behaviour out (the arm was in reach)
+    result: int | None = None      # its own reading of the outcome, an index into the scene's results
+    reading: dict | None = None    # the sensor values behind ``result`` (odometry, ...), for reports
 
 
 @dataclass(frozen=True)
 class Behavior:
-    """A named behaviour with its parameter list and its controller."""
+    """A named behaviour: its parameters, what it acts on, and its controller.
+
+    Behaviours are data as far as everything outside ``sim`` is concerned (``to_json`` is
+    what artefacts store, and what learners and planners read):
+
+    ``target``
+        ``"object"``: the behaviour acts on one perceived object, whose features the
+        controller gets (chapters 7-9); ``None``: it acts on nothing in particular (a
+        mobile robot moves, and everything it sees may change; chapters 5-6).
+    ``parameters``
+        alpha, each with its range and whether it is periodic (chapter 9's approach angle).
+    """
 
     name: str
     parameters: tuple[Parameter, ...]
-    controller: Callable[["TableWorld", np.ndarray, np.ndarray], Execution]
+    controller: Callable[..., Execution]
     description: str = ""
+    target: str | None = "object"
 
     def to_json(self) -> dict:
         return {"name": self.name, "parameters": [p.to_json() for p in self.parameters],
-                "description": self.description}
+                "description": self.description, "target": self.target}
 
-    def __call__(self, world: "TableWorld", target: np.ndarray, alpha: np.ndarray | None = None) -> Execution:
+    def __call__(self, world, target: np.ndarray | None, alpha: np.ndarray | None = None) -> Execution:
         alpha = np.zeros(0) if alpha is None else np.asarray(alpha, dtype=float)
         if alpha.shape != (len(self.parameters),):
             raise ValueError(f"{self.name} takes {len(self.parameters)} parameter(s), got {alpha.size}")
@@ -153,9 +174,8 @@ def _approach(world: "TableWorld", start: np.ndarray, aim: np.ndarray, yaw: floa
 
 
 def _box(target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Centre and half extents of a perceived object's bounding box (position channel)."""
-    p = target[1:7]
-    lo, hi = p[0::2], p[1::2]
+    """Centre and half extents of a perceived object's bounding box."""
+    lo, hi = extents(target)
     return (lo + hi) / 2, (hi - lo) / 2
 
 

@@ -1,8 +1,17 @@
-"""Exploration (thesis Algorithm 5): play with random objects, record what happens.
+"""Exploration: the robot acts in random worlds and records what happens.
 
-Per episode (trial): a fresh world with one random object; while the object is visible
-and the last behaviour moved it (perceived), perceive, run a random behaviour with random
-parameters, perceive again, and record <f^(), b, alpha, f^(b)> with ground truth.
+Two loops, chosen by the scene (``scene.loop``):
+
+``play`` (thesis Algorithm 5, chapter 8)
+    Per episode (trial): a fresh world with one random object; while the object is
+    visible and the last behaviour moved it (perceived), perceive, run a random behaviour
+    with random parameters, perceive again, and record <f^(), b, alpha, f^(b)> with
+    ground truth. Each look is stored once as an entity.
+``scan`` (thesis Algorithm 1, chapter 5)
+    Per episode: a random environment, scanned once (one entity); then every behaviour in
+    turn, each from the same start in a freshly built world (the thesis's "reset robot
+    and object positions"), recording <r, f, b> where r is the robot's own reading of
+    whether the behaviour succeeded. Nothing is perceived after a behaviour.
 
 Episode ``i`` draws everything from its own generator, seeded by ``(seed, i)``, so the
 rows are the same whatever the number of workers and whichever worker ran the episode.
@@ -17,11 +26,11 @@ import numpy as np
 
 from features import Interactions
 from features.interactions import OUTCOMES
-from features.objects import POSITION
-from sim.objects import SHAPES, ObjectSpec
+from sim.objects import SHAPES
 from sim.world import ObjectTruth, TableWorld
 
-__all__ = ["explore", "run_episode", "interact", "Step", "episode_rng", "outcome_label", "MOVED", "LIFTED"]
+__all__ = ["explore", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
+           "MOVED", "LIFTED"]
 
 #: A perceived position change above this (metres) counts as "the object moved".
 MOVED = 0.015
@@ -86,27 +95,37 @@ class _Rows:
     truth: dict
 
 
-def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interactions:
+def run_episode(scene, seed: int, episode: int, max_steps: int | None = None) -> Interactions:
+    """One episode of the scene's loop (``play`` or ``scan``) in fresh worlds; returns its rows."""
+    if scene.loop == "scan":
+        return run_scan_episode(scene, seed, episode)
+    return run_play_episode(scene, seed, episode, scene.config.max_steps if max_steps is None else max_steps)
+
+
+def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interactions:
     """One trial of Algorithm 5 in a fresh world; returns its rows."""
     rng = episode_rng(seed, episode)
-    spec = scene.sample_object(rng)
-    world = scene.build([spec], rng)
+    specs = scene.sample(rng)
+    spec = specs[0]
+    world = scene.build(specs, rng)
+    schema = scene.schema
+    moving = schema.geometry
     behaviors = scene.behaviors
     n_params = max((len(b.parameters) for b in behaviors), default=0)
     rows = _Rows([], [], [], [], [], {k: [] for k in (
         "shape", "size", "pose_before", "pose_after", "in_hand_before", "in_hand_after",
         "reachable", "contact", "outcome")})
     f = world.perceive()
+    looks = [f[0]] if f.shape[0] else []
     steps = 0
-    while f.shape[0] and f[0, 0] == 1.0 and steps < max_steps:
+    while f.shape[0] and schema.visible(f[0]) and steps < max_steps:
         b = int(rng.integers(len(behaviors)))
         behavior = behaviors[b]
         alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
         step = interact(world, behavior, 0, alpha, before=f)
         f1 = step.after
         t0, t1 = step.truth_before[0], step.truth_after[0]
-        rows.before.append(f[0])
-        rows.after.append(f1[0])
+        looks.append(f1[0])
         rows.behavior.append(b)
         padded = np.zeros(n_params)
         padded[: alpha.size] = alpha
@@ -125,11 +144,11 @@ def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interact
         tr["contact"].append(step.contact)
         tr["outcome"].append(step.outcomes[0])
         steps += 1
-        moved = np.abs(f1[0, POSITION] - f[0, POSITION]).max() > MOVED
+        moved = np.abs(f1[0, moving] - f[0, moving]).max() > MOVED
         f = f1
         if not moved:
             break
-    n = len(rows.before)
+    n = len(rows.behavior)
     d = len(scene.schema)
     dtypes = {"shape": np.int8, "outcome": np.int8, "in_hand_before": bool, "in_hand_after": bool,
               "reachable": bool, "contact": bool}
@@ -140,8 +159,9 @@ def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interact
     return Interactions(
         schema=scene.schema,
         behaviors=[b.to_json() for b in behaviors],
-        before=np.array(rows.before, dtype=np.float64).reshape(n, d),
-        after=np.array(rows.after, dtype=np.float64).reshape(n, d),
+        entities=np.array(looks[: n + 1] if n else [], dtype=np.float32).reshape(n + 1 if n else 0, d),
+        before_index=np.arange(n, dtype=np.int32),
+        after_index=np.arange(1, n + 1, dtype=np.int32),
         behavior=np.array(rows.behavior, dtype=np.int16),
         params=np.array(rows.params, dtype=np.float64).reshape(n, n_params),
         episode=np.full(n, episode, dtype=np.int32),
@@ -152,7 +172,43 @@ def run_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interact
     )
 
 
-def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int) -> list[Interactions]:
+def run_scan_episode(scene, seed: int, episode: int) -> Interactions:
+    """One trial of Algorithm 1: a random environment, scanned once, every behaviour tried
+    from the same start in a freshly built world; the label is the robot's own reading."""
+    rng = episode_rng(seed, episode)
+    layout = scene.sample(rng)
+    entity = np.asarray(scene.build(layout, rng).perceive(), dtype=np.float32)
+    behaviors = scene.behaviors
+    n_params = max((len(b.parameters) for b in behaviors), default=0)
+    params, results, truth = [], [], []
+    for behavior in behaviors:
+        alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
+        world = scene.build(layout, rng)
+        execution = behavior(world, None, alpha)
+        padded = np.zeros(n_params)
+        padded[: alpha.size] = alpha
+        params.append(padded)
+        results.append(execution.result)
+        truth.append(world.truth_row())
+    n = len(behaviors)
+    return Interactions(
+        schema=scene.schema,
+        behaviors=[b.to_json() for b in behaviors],
+        entities=entity.reshape(1, -1),
+        before_index=np.zeros(n, dtype=np.int32),
+        after_index=None,
+        behavior=np.arange(n, dtype=np.int16),
+        params=np.array(params, dtype=np.float64).reshape(n, n_params),
+        episode=np.full(n, episode, dtype=np.int32),
+        step=np.zeros(n, dtype=np.int16),
+        result=np.array(results, dtype=np.int8),
+        result_names=list(scene.results),
+        truth={k: np.array([t[k] for t in truth]) for k in (truth[0] if truth else {})},
+        scene=scene.describe(),
+    )
+
+
+def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int | None) -> list[Interactions]:
     return [run_episode(scene, seed, e, max_steps) for e in episodes]
 
 
@@ -168,7 +224,7 @@ def explore(
     interactions: int | None = None,
     seed: int = 0,
     workers: int = 1,
-    max_steps: int = 10,
+    max_steps: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     chunk: int = 8,
 ) -> Interactions:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Callable, TypeVar
 
-__all__ = ["register_scene", "get_scene", "scene_names", "SceneNotFound"]
+__all__ = ["register_scene", "get_scene", "scene_names", "make_scene", "SceneNotFound"]
 
 _SCENES: dict[str, type] = {}
 T = TypeVar("T", bound=type)
@@ -45,3 +45,17 @@ def get_scene(name: str) -> type:
         return _SCENES[name]
     except KeyError:
         raise SceneNotFound(f"unknown scene {name!r}; known scenes: {', '.join(sorted(_SCENES))}") from None
+
+
+def make_scene(name: str, **options):
+    """An instance of the registered scene ``name``, configured with ``options``.
+
+    Options the scene does not have raise :class:`sim.scene.SceneOptionError` (a usage
+    error); a bad value raises ValueError; both in one sentence.
+    """
+    from sim.scene import check_options
+
+    scene = get_scene(name)()
+    check_options(scene, options)
+    given = {k: v for k, v in options.items() if v is not None and k in scene.options}
+    return scene.configure(**given) if given else scene

@@ -1,33 +1,47 @@
 """A scene a planner or a predictor can drive: perceive, act, perceive again.
 
 ``SimWorld`` implements the small ``World`` protocol that ``plan`` talks to (``perceive``
-and ``act``), so that closed-loop execution never imports the simulator. It keeps one
-physics world for the whole session (the objects stay where the last behaviour left them)
-and the last step's ground truth for reports.
+and ``act``), so that closed-loop execution never imports the simulator. For a scene that
+plays (Algorithm 5) it keeps one physics world for the whole session (the objects stay
+where the last behaviour left them); for a scene that scans (Algorithm 1) every behaviour
+starts from the same start in a freshly built world, as in exploration, and the robot
+keeps its own reading of how each went. It keeps every step's ground truth for reports.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from sim.explore import Step, interact
-from sim.objects import ObjectSpec
+from dataclasses import dataclass
 
-__all__ = ["SimWorld"]
+from sim.explore import Step, interact
+
+__all__ = ["SimWorld", "Trial"]
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One behaviour run from the scanned start (a scan scene): the robot's reading, and the truth."""
+
+    behavior: str
+    executed: bool
+    result: int | None
+    reading: dict | None
+    truth: dict
 
 
 class SimWorld:
     """One scene with given objects, driven behaviour by behaviour."""
 
-    def __init__(self, scene, objects: list[ObjectSpec], seed: int = 0):
-        scene.check_layout(objects)
+    def __init__(self, scene, layout, seed: int = 0):
+        scene.check_layout(layout)
         self.scene = scene
-        self.objects = list(objects)
+        self.layout = layout
         self.rng = np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(2**31,)))
-        self.world = scene.build(self.objects, self.rng)
+        self.world = scene.build(self.layout, self.rng)
         self._behaviors = {b.name: b for b in scene.behaviors}
-        self.state = self.world.perceive()
-        self.history: list[Step] = []
+        self.state = np.asarray(self.world.perceive())
+        self.history: list[Step | Trial] = []
 
     @property
     def behavior_names(self) -> list[str]:
@@ -40,12 +54,26 @@ class SimWorld:
     @property
     def last_executed(self) -> bool:
         """Did the arm carry out the last behaviour? (No: its target lay beyond reach.)"""
-        return self.history[-1].executed if self.history else True
+        return self.history[-1].executed if self.history else True  # Step and Trial both say
+
+    @property
+    def last_result(self) -> int | None:
+        """The robot's own reading of the last behaviour (scenes whose labels are given)."""
+        last = self.history[-1] if self.history else None
+        return last.result if isinstance(last, Trial) else None
 
     def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:
-        """Run ``behavior`` on tracked object ``target``; return what is perceived after."""
+        """Run ``behavior`` on tracked object ``target`` (any, for a behaviour without a
+        target); return what is perceived after."""
         if behavior not in self._behaviors:
             raise ValueError(f"unknown behaviour {behavior!r}; this scene has {', '.join(self._behaviors)}")
+        b = self._behaviors[behavior]
+        if self.scene.loop == "scan":
+            world = self.scene.build(self.layout, self.rng)  # every behaviour from the same start
+            execution = b(world, None, alpha)
+            self.history.append(Trial(behavior, execution.executed, execution.result, execution.reading,
+                                      world.truth_row()))
+            return self.perceive()
         if not 0 <= target < self.state.shape[0]:
             raise ValueError(f"there is no object {target}; the robot sees {self.state.shape[0]}")
         step = interact(self.world, self._behaviors[behavior], target, alpha, before=self.state)

@@ -16,6 +16,7 @@ import sapien
 
 from features import RegionOfInterest, perceive, track
 from features.objects import N_OBJECT_FEATURES
+from features.objects import centres as object_centres
 from sim.camera import CameraConfig, MeshInstance, RangeCamera
 from sim.hand import Hand, HandConfig
 from sim.objects import ObjectSpec, build_object, object_mesh
@@ -213,8 +214,7 @@ class TableWorld:
         if seen.shape[0] == 0 or not self.bodies:
             self.identity = []
             return
-        p = seen[:, 1:7]
-        centres = np.column_stack([(p[:, 0] + p[:, 1]) / 2, (p[:, 2] + p[:, 3]) / 2])
+        centres = object_centres(seen)[:, :2]
         true = np.array([np.asarray(b.pose.p[:2]) for b in self.bodies])
         cost = np.linalg.norm(centres[:, None, :] - true[None, :, :], axis=2)
         rows, cols = linear_sum_assignment(cost)

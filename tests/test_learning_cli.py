@@ -88,7 +88,7 @@ def test_predict_with_check_runs_the_simulator(pipeline):
     assert len(out["objects"]) == 2
     for obj in out["objects"]:
         for name, p in obj["behaviors"].items():
-            assert abs(sum(p["probabilities"].values()) - 1) < 1e-3
+            assert abs(sum(p["probabilities"].values()) + p["unknown"] - 1) < 1e-3
             assert "held" in p and "outcome" in p
     assert out["checked"] == 8 and 0 <= out["held"] <= 8
 
@@ -127,7 +127,7 @@ def _variant(pipeline, tmp_path, name, change):
 def _unchecked(data):
     from afford_cli.datasets import behaviour_counts
 
-    arrays = {k: getattr(data, k) for k in ("before", "after", "behavior", "params", "episode", "step")}
+    arrays = {k: getattr(data, k) for k in ("entities", "before_index", "after_index", "behavior", "params", "episode", "step")}
     arrays.update({"truth_" + k: v for k, v in data.truth.items()})
     return arrays, {"schema": data.schema.to_json(), "behaviors": data.behaviors, "scene": data.scene,
                     "shapes": data.shapes, "n_interactions": len(data), "counts": behaviour_counts(data)}
@@ -144,7 +144,7 @@ def test_clear_errors(pipeline, tmp_path):
     assert "no interactions of behaviour 'lift'" in _err(["cluster", str(no_lift), "-o", str(tmp_path / "x")])
 
     def nan(d):
-        d.before[3, 5] = np.nan
+        d.entities[d.before_index[3], 5] = np.nan
         return d
     assert "NaN" in _err(["cluster", str(_variant(pipeline, tmp_path, "nan", nan)), "-o", str(tmp_path / "x")])
 
@@ -152,7 +152,7 @@ def test_clear_errors(pipeline, tmp_path):
     assert "needs at least" in _err(["cluster", str(few), "-o", str(tmp_path / "x")])
 
     def one_category(d):
-        d.after[:] = d.before  # nothing ever happened
+        d.after_index = d.before_index.copy()  # nothing ever happened
         return d
     flat = _variant(pipeline, tmp_path, "flat", one_category)
     ok(["cluster", str(flat), "-o", str(tmp_path / "flat-effects.afford")])
@@ -167,7 +167,7 @@ def test_clear_errors(pipeline, tmp_path):
     other = _variant(pipeline, tmp_path, "other", other_schema)
     assert "another feature schema" in _err(["evaluate", str(pipeline / "model.afford"), str(other)])
     assert "needs 'interactions'" in _err(["evaluate", str(pipeline / "model.afford"), str(pipeline / "effects.afford")])
-    assert "needs 'effects' or 'features'" in _err(["train", str(pipeline / "train.afford"), "-o", str(tmp_path / "x")])
+    assert "run 'afford cluster' on it first" in _err(["train", str(pipeline / "train.afford"), "-o", str(tmp_path / "x")])
     assert not (tmp_path / "x").exists()
 
 

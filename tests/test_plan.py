@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -63,7 +65,7 @@ def goal(*exprs):
 
 
 def test_breadth_first_finds_the_shortest_plan_best_first_the_most_probable():
-    fm = ForwardModel([NUDGE, PUSH])
+    fm = ForwardModel([NUDGE, PUSH], SCHEMA)
     g = goal("0:x_min=0.4~0.01")
     short = breadth_first(fm, scene(0.0), g, max_depth=4)
     assert [s.behavior for s in short.steps] == ["push", "push"]
@@ -74,14 +76,14 @@ def test_breadth_first_finds_the_shortest_plan_best_first_the_most_probable():
 
 
 def test_best_first_prefers_the_more_probable_of_two_plans():
-    fm = ForwardModel([THROW, SWEEP])
+    fm = ForwardModel([THROW, SWEEP], SCHEMA)
     plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
     assert [s.behavior for s in plan.steps] == ["sweep"]
     assert plan.success_probability == pytest.approx(0.9)
 
 
 def test_depth_and_node_limits_are_respected():
-    fm = ForwardModel([NUDGE])
+    fm = ForwardModel([NUDGE], SCHEMA)
     g = goal("0:x_min=0.3~0.01")
     assert best_first(fm, scene(0.0), g, max_depth=3).found
     shallow = best_first(fm, scene(0.0), g, max_depth=2)
@@ -91,26 +93,26 @@ def test_depth_and_node_limits_are_respected():
 
 
 def test_any_object_goal_acts_on_whichever_object_works_best():
-    fm = ForwardModel([NUDGE])
+    fm = ForwardModel([NUDGE], SCHEMA)
     plan = best_first(fm, scene(0.0, 0.25), goal("*:x_min=0.35~0.01"))
     assert [(s.behavior, s.obj) for s in plan.steps] == [("nudge", 1)]
 
 
 def test_relative_goal_brings_two_objects_level():
-    fm = ForwardModel([NUDGE])
+    fm = ForwardModel([NUDGE], SCHEMA)
     plan = best_first(fm, scene(0.0, 0.2), goal("0-1:x_min=0~0.01"))
     assert [(s.behavior, s.obj) for s in plan.steps] == [("nudge", 0), ("nudge", 0)]
 
 
 def test_vanished_objects_cannot_be_acted_on():
-    fm = ForwardModel([NUDGE])
+    fm = ForwardModel([NUDGE], SCHEMA)
     state = scene(0.0)
     state[0, 0] = 0.0
     assert not best_first(fm, state, goal("0:x_min=0.1~0.01")).found
 
 
 def test_success_probability_counts_every_outcome_that_reaches_the_goal():
-    fm = ForwardModel([THROW])
+    fm = ForwardModel([THROW], SCHEMA)
     plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
     assert plan.success_probability == pytest.approx(0.5)
     twice = plan.steps * 2  # a second throw after a first miss
@@ -118,7 +120,7 @@ def test_success_probability_counts_every_outcome_that_reaches_the_goal():
 
 
 def test_inverse_query_ranks_one_step_options():
-    fm = ForwardModel([THROW, SWEEP, NUDGE], min_probability=0.0)
+    fm = ForwardModel([THROW, SWEEP, NUDGE], SCHEMA, min_probability=0.0)
     ranking = inverse_query(fm, scene(0.0), goal("*:visibility=0"))
     assert [(r["behavior"], r["probability"]) for r in ranking] == [("sweep", 0.9), ("throw", 0.5), ("nudge", 0.0)]
 
@@ -160,7 +162,7 @@ class ScriptedWorld:
 
 
 def test_monitoring_replans_when_a_step_surprises():
-    fm = ForwardModel([PUSH])
+    fm = ForwardModel([PUSH], SCHEMA)
     world = ScriptedWorld(scene(0.0), {"push": [effect(), effect(0.2), effect(0.2)]})  # the first push misses
     run = execute(world, fm, goal("0:x_min=0.4~0.01"), max_replans=3)
     assert run.reached and run.replans == 1
@@ -168,7 +170,7 @@ def test_monitoring_replans_when_a_step_surprises():
 
 
 def test_monitoring_stops_repeating_what_fails_and_tries_something_else():
-    fm = ForwardModel([SWEEP, THROW])
+    fm = ForwardModel([SWEEP, THROW], SCHEMA)
     world = ScriptedWorld(scene(0.0), {"sweep": [effect()], "throw": [effect(vanish=True)]})
     run = execute(world, fm, goal("*:visibility=0"), max_replans=3)
     assert run.reached
@@ -176,7 +178,7 @@ def test_monitoring_stops_repeating_what_fails_and_tries_something_else():
 
 
 def test_monitoring_gives_up_after_the_replan_budget():
-    fm = ForwardModel([PUSH])
+    fm = ForwardModel([PUSH], SCHEMA)
     world = ScriptedWorld(scene(0.0), {"push": [effect(0.05)]})  # always a little, never as predicted
     run = execute(world, fm, goal("0:x_min=0.4~0.01"), max_replans=2)
     assert not run.reached and run.replans <= 2 and run.reason
@@ -207,7 +209,7 @@ class Known:
 
 def test_unknown_effects_lower_the_probabilities_plans_count_on():
     risky = BehaviorModel("risky", Fixed([1.0]), np.array([0]), np.stack([effect(vanish=True)]), known=Known())
-    fm = ForwardModel([risky, SWEEP])
+    fm = ForwardModel([risky, SWEEP], SCHEMA)
     (out,) = fm.outcomes(scene(0.0), 0, 0)
     assert out.probability == pytest.approx(0.25)  # the rest is an outcome no plan counts on
     plan = best_first(fm, scene(0.0), goal("*:visibility=0"))
@@ -220,7 +222,7 @@ SLIDE = behaviour("slide", [(0.5, effect(0.2)), (0.5, effect())])
 
 def test_reach_probability_imagines_monitored_execution():
     g = goal("0:x_min=0.4~0.01")
-    fm = ForwardModel([PUSH_HALF])
+    fm = ForwardModel([PUSH_HALF], SCHEMA)
     plan = best_first(fm, scene(0.0), g)
     assert [s.behavior for s in plan.steps] == ["push", "push"]
     assert plan.success_probability == pytest.approx(0.36)  # both pushes must work, blind
@@ -232,7 +234,7 @@ def test_reach_probability_imagines_monitored_execution():
     # try, replanning cannot help (independent retries would claim 0.91).
     assert reach_probability(fm, scene(0.0), g, plan, max_replans=3, rollouts=n) == pytest.approx(0.36, abs=se)
     # With another behaviour to turn to, monitoring and replanning do help.
-    both = ForwardModel([PUSH_HALF, SLIDE])
+    both = ForwardModel([PUSH_HALF, SLIDE], SCHEMA)
     plan = best_first(both, scene(0.0), g)
     assert [s.behavior for s in plan.steps] == ["push", "push"]
     monitored = reach_probability(both, scene(0.0), g, plan, max_replans=3, rollouts=n, seed=1)
@@ -250,7 +252,7 @@ def test_min_steps_bounds_the_steps_left_and_prunes_hopeless_branches():
     assert g.min_steps(state) == 3  # objects 0 and 1, and one of 2 and 3
     state[0, 0] = 0.0
     assert g.min_steps(state) == 2
-    fm = ForwardModel([SWEEP])
+    fm = ForwardModel([SWEEP], SCHEMA)
     three = goal("0:visibility=0", "1:visibility=0", "2:visibility=0")
     shallow = best_first(fm, scene(0.0, 0.5, 1.0), three, max_depth=2)
     assert not shallow.found and shallow.expanded == 1  # no child can finish in time
@@ -264,10 +266,10 @@ def test_while_the_hand_holds_an_object_only_that_object_is_acted_on():
     lift = behaviour("lift", [(0.9, up), (0.1, effect())])
     both_up = goal("0:z_min=0.3~0.01", "1:z_min=0.3~0.01")
     # one hand cannot hold two objects up: lifting the second would drop the first
-    assert not best_first(ForwardModel([lift], height=z), scene(0.0, 0.5), both_up).found
-    assert best_first(ForwardModel([lift]), scene(0.0, 0.5), both_up).found  # a model that cannot tell
+    assert not best_first(ForwardModel([lift], SCHEMA, height=z), scene(0.0, 0.5), both_up).found
+    assert best_first(ForwardModel([lift], replace(SCHEMA, roles=())), scene(0.0, 0.5), both_up).found  # cannot tell
     # lift one, then push it along: the object in the hand may still be acted on
-    fm = ForwardModel([lift, NUDGE], height=z)
+    fm = ForwardModel([lift, NUDGE], SCHEMA, height=z)
     plan = best_first(fm, scene(0.0, 0.5), goal("0:z_min=0.3~0.01", "0:x_min=0.1~0.01"))
     assert plan.found and [s.obj for s in plan.steps] == [0, 0]
     # a replan that starts with object 1 in the hand lets go of it only where the goal
@@ -277,7 +279,7 @@ def test_while_the_hand_holds_an_object_only_that_object_is_acted_on():
 
 
 def test_reach_probability_stops_starting_rollouts_when_its_search_budget_is_spent():
-    fm = ForwardModel([PUSH_HALF, SLIDE])
+    fm = ForwardModel([PUSH_HALF, SLIDE], SCHEMA)
     g = goal("0:x_min=0.4~0.01")
     plan = best_first(fm, scene(0.0), g)
     full = reach_probability(fm, scene(0.0), g, plan, rollouts=1000, seed=2)
@@ -301,7 +303,7 @@ def test_a_surprise_that_helps_does_not_use_up_the_replans():
         return real_act(behavior, target, alpha)
 
     world.act = act
-    fm = ForwardModel([SWEEP])
+    fm = ForwardModel([SWEEP], SCHEMA)
     run = execute(world, fm, goal("0:visibility=0", "1:visibility=0", "2:visibility=0"), max_replans=1)
     assert run.windfalls == 1 and run.replans == 1 and len(world.calls) == 3
     assert "gave up after 1 replans" in run.reason  # a miss, by contrast, uses the budget up
@@ -328,7 +330,7 @@ def test_a_surprise_in_the_hand_is_distrusted_in_the_hand_only():
     # object with the hand hiding its shape; from the table, less likely
     drops = [BehaviorModel(name, Raised([0.9, 0.1], [0.6, 0.4]), np.array([z]),
                            np.stack([effect(vanish=True), effect()])) for name in ("drop-left", "drop-right")]
-    fm = ForwardModel([lift, *drops], height=z)
+    fm = ForwardModel([lift, *drops], SCHEMA, height=z)
     g = goal("0:visibility=0")
     assert [s.behavior for s in best_first(fm, scene(0.0), g).steps] == ["lift", "drop-left"]
     # this object lands back on the table when dropped; from the table, it goes
@@ -359,7 +361,7 @@ def near_only(name, outcomes):
 
 
 def test_best_plans_gives_different_sequences_most_probable_first():
-    fm = ForwardModel([THROW, SWEEP])
+    fm = ForwardModel([THROW, SWEEP], SCHEMA)
     plans = best_plans(fm, scene(0.0), goal("*:visibility=0"), 3, max_depth=2)
     sequences = [tuple(s.behavior for s in p.steps) for p in plans]
     assert sequences[:2] == [("sweep",), ("throw",)]
@@ -374,7 +376,7 @@ def test_plans_are_ranked_by_their_chance_with_monitoring_not_by_their_path():
     # 'sweep' works less often along its path, but a failed sweep can be swept again.
     gamble = near_only("gamble", [(0.95, effect(vanish=True)), (0.05, effect(5.0))])
     sweep = near_only("sweep", [(0.9, effect(vanish=True)), (0.1, effect(0.05))])
-    fm = ForwardModel([gamble, sweep])
+    fm = ForwardModel([gamble, sweep], SCHEMA)
     g = goal("*:visibility=0")
     assert [s.behavior for s in best_first(fm, scene(0.0), g).steps] == ["gamble"]
     ranked = rank_plans(fm, scene(0.0), g, 2, max_replans=3)
@@ -400,7 +402,7 @@ class ReachWorld(ScriptedWorld):
 
 
 def test_an_object_the_arm_cannot_reach_is_left_alone():
-    fm = ForwardModel([SWEEP, THROW])
+    fm = ForwardModel([SWEEP, THROW], SCHEMA)
     world = ReachWorld(scene(0.5, 0.0), {"sweep": [effect(vanish=True)], "throw": [effect(vanish=True)]}, far=0.4)
     run = execute(world, fm, goal("*:visibility=0"), max_replans=3)
     assert run.reached and run.replans == 1
@@ -409,7 +411,7 @@ def test_an_object_the_arm_cannot_reach_is_left_alone():
 
 
 def test_when_the_goal_needs_an_object_out_of_reach_the_robot_says_so():
-    fm = ForwardModel([SWEEP, THROW])
+    fm = ForwardModel([SWEEP, THROW], SCHEMA)
     world = ReachWorld(scene(0.5), {"sweep": [effect(vanish=True)], "throw": [effect(vanish=True)]}, far=0.4)
     run = execute(world, fm, goal("0:visibility=0"), max_replans=3)
     assert not run.reached and run.replans == 1 and len(world.calls) == 1

@@ -47,7 +47,8 @@ def info():
     ranked = sorted(scores, key=lambda n: -scores[n])
     return {
         "kind": "features",
-        "features": SCHEMA.to_json(),
+        "features": SCHEMA.to_json()["features"],
+        "histogram_columns": [list(h) for h in SCHEMA.histograms],
         "behaviors": {
             "push-left": {"categories": [category(0, 12, rng, {"fell": 0.9, "left-view": 0.1}),
                                          category(1, 30, rng, {"dragged": 1.0}),
@@ -94,7 +95,7 @@ def interactions_file(tmp_path):
     rng = np.random.default_rng(1)
     n = 12
     before = rng.random((n, len(SCHEMA)))
-    data = Interactions(
+    data = Interactions.from_rows(
         schema=SCHEMA,
         behaviors=[{"name": "push-left", "parameters": []}, {"name": "lift", "parameters": []}],
         before=before, after=before + rng.normal(0, 0.01, before.shape),

@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
+from afford_cli.errors import AffordError
 from afford_cli.learning import effects_members, read_rows
 from afford_cli.options import InputPath, Json, OutputPath, Seed
 from afford_cli.output import Output
@@ -43,6 +44,9 @@ def cluster(
     check_output(output)
     out = Output(json, stdout_busy=output == "-")
     art, data = read_rows(path)
+    if not data.has_after:
+        raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
+                          f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
     start = time.perf_counter()
     with out.progress("clustering effects (behaviours)", len(data.behaviors)) as update:
         models, labels = discover_effects(data, method=method.value, k_max=kmax, k=k, prune=prune.value,
@@ -55,11 +59,10 @@ def cluster(
                                    "categories": s["categories"]} for name, s in meta["effects"].items()}}
 
     def render(console):
-        from afford_cli.commands.inspect import _channels
         from afford_cli.reports import render_categories
 
         for name, s in meta["effects"].items():
-            render_categories(console, name, s["categories"], _channels(data.schema.to_json()))
+            render_categories(console, name, s["categories"], [(ch, [data.schema.names[i] for i in idx]) for ch, idx in data.schema.channel_groups()])
         console.print(f"-> {output} ({result['seconds']:.1f} s)")
 
     out.result(result, render)

@@ -22,6 +22,7 @@ def demo(
     workers: Workers = 2,
 ) -> None:
     """Explore the table scene, learn its affordances, and measure them on new interactions."""
+    from afford_cli.scenes_io import make_scene
     from afford_cli.commands import cluster, emulate, evaluate, explore, inspect, plan, predict, select_features, train
 
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -29,7 +30,7 @@ def demo(
     path = {k: str(out_dir / f"{k}.afford") for k in ("interactions", "heldout", "effects", "features", "model")}
 
     console.rule(f"[bold]1. explore: the robot pushes and lifts random objects ({interactions} interactions)")
-    _, s = explore.record(Output(), explore.make_scene("table"), path["interactions"], episodes=None,
+    _, s = explore.record(Output(), make_scene("table"), path["interactions"], episodes=None,
                           interactions=interactions, seed=seed, workers=workers)
     console.print(f"recorded {s['interactions']} interactions in {s['episodes']} episodes "
                   f"({s['interactions_per_second']}/s) -> {path['interactions']}; what the file holds, verified:")

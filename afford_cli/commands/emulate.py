@@ -10,9 +10,9 @@ import typer
 from afford_cli.commands.plan import render_plan
 from afford_cli.errors import AffordError
 from afford_cli.learning import forward_model, load_model
-from afford_cli.options import Alternatives, Json, SceneName
+from afford_cli.options import Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
 from afford_cli.output import Output
-from afford_cli.scenes_io import open_world, scene_objects
+from afford_cli.scenes_io import open_world, scene_layout
 
 
 def emulate(
@@ -21,9 +21,9 @@ def emulate(
     start: Annotated[str, typer.Option("--start", help="Layout of the scene the robot starts from.")],
     scene: SceneName = "table",
     execute: Annotated[bool, typer.Option("--execute/--no-execute", help="Run the plan in the simulator with monitoring.")] = True,
-    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")] = 5,
-    max_nodes: Annotated[int, typer.Option("--max-nodes", min=1)] = 20000,
-    max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
+    max_depth: MaxDepth = 5,
+    max_nodes: MaxNodes = 20000,
+    max_replans: MaxReplans = 3,
     seed: Annotated[int, typer.Option("--seed", "-s", min=0, help="Seed of the simulated worlds (noise).")] = 0,
     alternatives: Alternatives = 3,
     json: Json = False,
@@ -34,9 +34,10 @@ def emulate(
     from plan.monitor import rank_plans, ranked_planner
 
     loaded = load_model(model)
+    loaded.check_effects("emulation")
     fm = forward_model(loaded)
-    sc, shown = scene_objects(scene, None, 1, observe, allow_empty=True)
-    _, specs = scene_objects(scene, None, 1, start)
+    sc, shown = scene_layout(scene, None, observe, allow_empty=True)
+    _, specs = scene_layout(scene, None, start)
     observed = open_world(sc, shown, seed).perceive() if shown else np.empty((0, len(loaded.schema)))
     world = open_world(sc, specs, seed + 1)
     state = world.perceive()

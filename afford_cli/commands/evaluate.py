@@ -33,13 +33,22 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
         rows = np.flatnonzero(data.behavior == b)
         if rows.size == 0:
             raise AffordError(f"the data hold no interactions of behaviour {name!r}")
-        # The true category, as training would have labelled the effect; effects of the
-        # kinds training discarded (rare ones) are counted apart, not scored.
-        y = model.effects[name].assign(data.effects[rows])
+        if model.label_source == "given":
+            # the robot's own reading of each held-out interaction
+            if data.result is None or data.result_names != model.result_names:
+                raise AffordError(f"the model's labels are given results ({'/'.join(model.result_names)}), "
+                                  "but the data give none")
+            y = data.result[rows].astype(int)
+        else:
+            # The true category, as training would have labelled the effect; effects of the
+            # kinds training discarded (rare ones) are counted apart, not scored.
+            if not data.has_after:
+                raise AffordError("the model predicts effect categories, but the data record no effects")
+            y = model.effects[name].assign(data.effects_of(rows))
         known = y >= 0
         if not known.any():
             raise AffordError(f"none of the {rows.size} {name!r} interactions falls into a category the model knows")
-        X = predictor_inputs(data.before[rows], data.params[rows], model.selected[name], model.n_params(name))
+        X = predictor_inputs(data.before_rows(rows), data.params[rows], model.selected[name], model.parameters(name))
         predictor = model.predictors[name]
         proba = predictor.predict_proba(X[known])
         m = evaluate_predictions(y[known], proba, predictor.classes_)

@@ -7,36 +7,16 @@ from typing import Annotated, Optional
 
 import typer
 from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.datasets import behaviour_counts, interactions_members, outcome_table
-from afford_cli.reports import render_outcome_table
+from afford_cli.datasets import behaviour_counts, interactions_members, outcome_table, result_rates
+from afford_cli.reports import render_outcome_table, render_result_rates
+from afford_cli.scenes_io import make_scene
 from afford_cli.errors import AffordError
 from afford_cli.options import Json, OutputPath, SceneName, Seed, Workers
 from afford_cli.output import Output
 
 
-def make_scene(name: str, size_min: float | None = None, size_max: float | None = None):
-    """Instantiate a registered scene, applying size options where given."""
-    from dataclasses import replace
-
-    from sim.registry import SceneNotFound, get_scene
-
-    try:
-        cls = get_scene(name)
-    except SceneNotFound as exc:
-        raise AffordError(str(exc)) from None
-    scene = cls()
-    if size_min is not None or size_max is not None:
-        lo, hi = scene.config.size_range
-        lo = lo if size_min is None else size_min
-        hi = hi if size_max is None else size_max
-        if lo > hi:
-            raise AffordError(f"--size-min ({lo}) is larger than --size-max ({hi})")
-        scene = cls(replace(scene.config, size_range=(lo, hi)))
-    return scene
-
-
 def run_explore(out: Output, scene, *, episodes: int | None, interactions: int | None, seed: int,
-                workers: int, max_steps: int):
+                workers: int, max_steps: int | None = None):
     """Explore with a progress bar; returns (data, seconds)."""
     from sim.explore import explore as run
 
@@ -58,11 +38,15 @@ def summary(data, seconds: float) -> dict:
         "seconds": round(seconds, 3),
         "interactions_per_second": round(len(data) / seconds, 2) if seconds > 0 else None,
         "counts": behaviour_counts(data),
+        "label_source": data.label_source,
+        "n_features": len(data.schema),
+        "channels": {ch: int(idx.size) for ch, idx in data.schema.channel_groups()},
+        **({"result_rates": result_rates(data)} if data.result is not None else {}),
     }
 
 
 def record(out: Output, scene, output: str, *, episodes: int | None, interactions: int | None, seed: int,
-           workers: int, max_steps: int = 10):
+           workers: int, max_steps: int | None = None):
     """Explore, write the ``interactions`` artefact to ``output``; returns (data, summary)."""
     data, seconds = run_explore(out, scene, episodes=episodes, interactions=interactions, seed=seed,
                                 workers=workers, max_steps=max_steps)
@@ -78,16 +62,16 @@ def record(out: Output, scene, output: str, *, episodes: int | None, interaction
 def explore(
     output: OutputPath,
     scene: SceneName = "table",
-    episodes: Annotated[Optional[int], typer.Option("--episodes", "-n", min=1, help="Exploration episodes (trials of Algorithm 5).")] = None,
+    episodes: Annotated[Optional[int], typer.Option("--episodes", "-n", min=1, help="Exploration episodes (trials of the scene's loop: Algorithm 5 or 1).")] = None,
     interactions: Annotated[Optional[int], typer.Option("--interactions", min=1, help="Stop once this many interactions are recorded (instead of --episodes).")] = None,
     seed: Seed = 0,
     workers: Workers = 1,
-    max_steps: Annotated[int, typer.Option("--max-steps", min=1, help="Most behaviours per episode.")] = 10,
-    size_min: Annotated[Optional[float], typer.Option("--size-min", help="Smallest object dimension, metres.")] = None,
-    size_max: Annotated[Optional[float], typer.Option("--size-max", help="Largest object dimension, metres.")] = None,
+    max_steps: Annotated[Optional[int], typer.Option("--max-steps", min=1, help="Most behaviours per episode (scenes that play, Algorithm 5; 10 by default).")] = None,
+    size_min: Annotated[Optional[float], typer.Option("--size-min", help="Smallest object dimension, metres (scenes with random objects).")] = None,
+    size_max: Annotated[Optional[float], typer.Option("--size-max", help="Largest object dimension, metres (scenes with random objects).")] = None,
     json: Json = False,
 ) -> None:
-    """Let the robot explore: random objects, random behaviours, effects recorded (Algorithm 5)."""
+    """Let the robot explore: random worlds, its behaviours, what happened recorded (Algorithm 5 or 1)."""
     if episodes is not None and interactions is not None:
         raise typer.BadParameter("give --episodes or --interactions, not both")
     if episodes is None and interactions is None:
@@ -99,13 +83,18 @@ def explore(
         raise typer.BadParameter(f"--size-min ({size_min}) is larger than --size-max ({size_max})")
     check_output(output)
     out = Output(json, stdout_busy=output == "-")
-    sc = make_scene(scene, size_min, size_max)
+    sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps)
     data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
-                          workers=workers, max_steps=max_steps)
+                          workers=workers)
 
     def render(console):
         console.print(f"[bold]explored[/] {result['interactions']} interactions in {result['episodes']} episodes, "
                       f"{result['seconds']:.1f} s ({result['interactions_per_second']}/s) -> {output}")
-        render_outcome_table(console, outcome_table(data))
+        console.print("features: " + ", ".join(f"{ch} {n}" for ch, n in result["channels"].items())
+                      + f" ({result['n_features']} in all); labels {result['label_source']}")
+        if data.result is not None:
+            render_result_rates(console, result["result_rates"])
+        else:
+            render_outcome_table(console, outcome_table(data))
 
     out.result(result, render)

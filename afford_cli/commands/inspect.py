@@ -10,7 +10,8 @@ from afford_cli.datasets import behaviour_counts, interactions_from_artifact, ou
 from afford_cli.options import InputPath, Json
 from afford_cli.output import Output
 from afford_cli.plots import PlotDir, artefact_plots, plot_directory, written
-from afford_cli.reports import render_categories, render_outcome_table
+from afford_cli.reports import render_categories, render_outcome_table, render_result_rates
+from features import FeatureSchema
 
 
 def describe(art: Artifact) -> dict:
@@ -27,9 +28,26 @@ def describe(art: Artifact) -> dict:
         "parents": m.get("parents", []),
         "verified": True,
         "members": sorted(m.get("members", {})),
-        "features": m.get("schema", []),
+        "features": [],
         "behavior_names": [b["name"] for b in m.get("behaviors", [])],
     }
+    if "schema" in m:
+        try:
+            schema = FeatureSchema.from_json(m["schema"])
+        except (KeyError, TypeError, ValueError, AttributeError):
+            raise AffordError(f"{art.source} has a malformed feature schema; it is corrupt or was edited") from None
+        info["features"] = [{"name": n, "channel": c} for n, c in zip(schema.names, schema.channels)]
+        info["channels"] = [{"channel": ch, "n": int(idx.size), "unit": schema.channel(ch).unit,
+                             "tolerance": schema.channel(ch).tolerance} for ch, idx in schema.channel_groups()]
+        info["visibility"] = schema.visibility
+        info["histograms"] = len(schema.histograms)
+        info["histogram_columns"] = [list(h) for h in schema.histograms]
+    if "label_source" in m or "n_interactions" in m:
+        info["label_source"] = m.get("label_source", "discovered")
+    if m.get("result_rates"):
+        info["result_rates"] = m["result_rates"]
+    if m.get("relevance"):
+        info["n_selected"] = {name: len(r.get("selected", [])) for name, r in m["relevance"].items()}
     if "effects" in m:
         info["behaviors"] = _behaviour_reports(m)
     if art.kind == "model":
@@ -71,6 +89,12 @@ def render(console, info: dict) -> None:
             shown = ", ".join(names) if len(names) <= 8 else ", ".join(names[:3]) + f", ... , {names[-1]}"
             ft.add_row(ch, str(len(names)), shown)
         console.print(ft)
+    if info.get("result_rates"):
+        render_result_rates(console, info["result_rates"])
+    if info.get("n_selected"):
+        n = len(info["features"])
+        console.print("relevant features kept: " + ", ".join(
+            f"{b} {k} of {n} ({100 * k / max(n, 1):.1f} %)" for b, k in info["n_selected"].items()))
     if info.get("counts"):
         ct = Table(title="interactions per behaviour")
         ct.add_column("behaviour")

@@ -12,54 +12,18 @@ from rich.table import Table
 
 from afford_cli.errors import AffordError
 from afford_cli.learning import forward_model, load_model
-from afford_cli.options import Alternatives, Json, SceneName
+from afford_cli.options import (
+    Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
+)
 from afford_cli.output import Output
-from afford_cli.scenes_io import open_world, scene_objects
+from afford_cli.planning import parse_goals, plan_once
+from afford_cli.scenes_io import scene_layout
+from plan.report import summarise
 
 
 class SearchMethod(str, Enum):
     best_first = "best-first"
     bfs = "bfs"
-
-
-def parse_goals(expressions: list[str], schema):
-    from plan.goals import GoalError, parse_goal
-
-    try:
-        return parse_goal(expressions, schema)
-    except GoalError as exc:
-        raise AffordError(str(exc)) from None
-
-
-def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int,
-              alternatives: int = 3) -> dict:
-    """Plan in one scene (and execute with monitoring); the result as plain data.
-
-    With ``alternatives`` > 1 the most probable plans are ranked by their success
-    probability with monitoring, the first is the plan (and every replan is chosen the same
-    way), and the others are reported under ``alternatives``.
-    """
-    from plan.monitor import execute as run
-    from plan.monitor import rank_plans, ranked_planner
-
-    world = open_world(scene, specs, seed)
-    start = world.perceive()
-    model.check_schema(scene.schema, "this scene's perception")
-    goal.check_objects(start.shape[0])
-    ranked = rank_plans(fm, start, goal, alternatives, max_replans=max_replans, method=method, **limits)
-    first = ranked[0]
-    out = {"seed": seed, "objects": start.shape[0], "plan": first.to_json(), "tree": first.tree[:12]}
-    if alternatives > 1:
-        out["alternatives"] = [p.to_json() for p in ranked[1:]]
-    if execute and first.found:
-        planner = ranked_planner(fm, goal, alternatives, max_replans=max_replans, method=method, **limits)
-        result = run(world, fm, goal, method=method, max_replans=max_replans, first=first, planner=planner, **limits)
-        out["execution"] = result.to_json()
-        out["reached"] = result.reached
-        out["replans"] = result.replans
-        # did the first plan, as planned, work without replanning?
-        out["first_plan_worked"] = result.reached and result.replans == 0 and result.windfalls == 0
-    return out
 
 
 def render_plan(console, entry: dict, goal_text: list[str]) -> None:
@@ -103,25 +67,24 @@ def plan(
     model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
     goal: Annotated[list[str], typer.Option("--goal", help="OBJ:FEATURE=VALUE~RANGE; repeat for several (all must hold).")],
     scene: SceneName = "table",
-    seed: Annotated[Optional[int], typer.Option("--seed", "-s", min=0, help="Draw a random scene from this seed.")] = None,
-    objects: Annotated[int, typer.Option("--objects", min=1, max=6, help="Objects in a drawn scene.")] = 1,
-    layout: Annotated[Optional[str], typer.Option("--layout", help="A TOML layout file that pins the scene.")] = None,
-    max_depth: Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")] = 5,
-    max_nodes: Annotated[int, typer.Option("--max-nodes", min=1, help="Most search nodes to expand.")] = 20000,
+    seed: SceneSeed = None,
+    objects: Objects = None,
+    layout: Layout = None,
+    max_depth: MaxDepth = 5,
+    max_nodes: MaxNodes = 20000,
     method: Annotated[SearchMethod, typer.Option("--search", help="Most probable plan (best-first) or the thesis's breadth-first chaining.")] = SearchMethod.best_first,
     execute: Annotated[bool, typer.Option("--execute", help="Run the plan in the simulator, monitor it and replan on surprises.")] = False,
-    max_replans: Annotated[int, typer.Option("--max-replans", min=0, max=20)] = 3,
+    max_replans: MaxReplans = 3,
     episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
     reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
     alternatives: Alternatives = 3,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
-    if layout is not None and (episodes > 1 or reachable or seed is not None or objects != 1):
-        raise typer.BadParameter("--layout pins the scene; it does not go with --seed, --objects, --reachable or --episodes")
-    if layout is None and seed is None:
-        raise typer.BadParameter("give --layout FILE, or --seed S to draw a random scene")
+    check_scene_source(layout, seed, objects=objects, reachable=reachable or None,
+                       episodes=episodes if episodes > 1 else None)
     loaded = load_model(model)
+    loaded.check_effects("planning")
     fm = forward_model(loaded)
     g = parse_goals(goal, loaded.schema)
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}
@@ -129,12 +92,12 @@ def plan(
     base = seed or 0
     entries = []
     if episodes == 1:
-        sc, specs = scene_objects(scene, seed, objects, layout, reachable)
+        sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable)
         entries.append(plan_once(loaded, fm, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
-                sc, specs = scene_objects(scene, base + e, objects, None, reachable)
+                sc, specs = scene_layout(scene, base + e, None, objects=objects, reachable=reachable)
                 try:
                     entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
                 except (AffordError, ValueError) as exc:  # e.g. an object hidden behind another
@@ -153,35 +116,6 @@ def plan(
             render_summary(console, result)
 
     out.result(result, render)
-
-
-def summarise(entries: list[dict], executed: bool) -> dict:
-    by_length: dict[str, dict] = {}
-    probs, blind, first_ok = [], [], []
-    for e in entries:
-        p = e["plan"]
-        if not p["found"]:
-            continue
-        key = str(p["length"])
-        slot = by_length.setdefault(key, {"found": 0, "reached": 0})
-        slot["found"] += 1
-        probs.append(p["success_probability"])
-        blind.append(p["open_loop_probability"])
-        if executed:
-            slot["reached"] += int(e.get("reached", False))
-            first_ok.append(bool(e.get("first_plan_worked", False)))
-    found = sum(1 for e in entries if e["plan"]["found"])
-    planned = [e for e in entries if "skipped" not in e]
-    out = {"episodes": len(entries), "skipped": len(entries) - len(planned), "found": found, "by_length": dict(sorted(by_length.items(), key=lambda kv: int(kv[0]))),
-           "mean_success_probability": round(float(np.mean(probs)), 4) if probs else None,
-           "mean_open_loop_probability": round(float(np.mean(blind)), 4) if blind else None,
-           "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in planned] or [0.0])), 4),
-           "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in planned] or [0.0])), 1)}
-    if executed:
-        out["reached"] = sum(int(e.get("reached", False)) for e in entries)
-        out["first_plan_worked"] = int(sum(first_ok))
-    out["runs"] = entries if len(entries) > 1 else []
-    return out
 
 
 def render_summary(console, result: dict) -> None:

@@ -30,12 +30,12 @@ def select_features(
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
-    """Rank the object features by relevance to each behaviour's effect categories."""
+    """Rank the entity features by relevance to each behaviour's labels (effect categories, or given results)."""
     from learn.affordances import rank_features
 
     check_output(output)
     out = Output(json, stdout_busy=output == "-")
-    art, data = read_rows(path, ("effects", "features"))
+    art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
     start = time.perf_counter()
     with out.progress(f"selecting features ({method.value})", len(data.behaviors)) as update:

@@ -27,18 +27,18 @@ def train(
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
-    """Train each behaviour's effect-category predictor (thesis 8.4.2), probabilities calibrated."""
+    """Train each behaviour's predictor of its labels (effect categories or given results), probabilities calibrated."""
     from learn.affordances import train_known, train_predictors
 
     check_output(output)
     out = Output(json, stdout_busy=output == "-")
-    art, data = read_rows(path, ("effects", "features"))
+    art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, effects = read_effects(art, data)
     selected = read_selection(art, data)
     start = time.perf_counter()
     with out.progress(f"training predictors ({kernel.value} SVM)", len(data.behaviors)) as update:
         predictors = train_predictors(data, labels, selected, kernel=kernel.value, seed=seed, progress=update)
-    known = train_known(data, labels, seed=seed)
+    known = train_known(data, labels, seed=seed) if effects is not None else None
     settings = {"kernel": kernel.value, "selection": art.kind}
     arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known)
     write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))

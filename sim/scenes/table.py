@@ -32,9 +32,12 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from dataclasses import replace
+
 from features import object_schema
 from sim.behaviors import TABLE_BEHAVIORS
 from sim.camera import RangeCamera
+from sim.layout import layout_toml, parse_layout
 from sim.objects import SHAPES, ObjectSpec
 from sim.registry import register_scene
 from sim.world import TableConfig, TableWorld
@@ -52,11 +55,15 @@ class TableSceneConfig:
     """Shapes to draw from, equally likely."""
     world: TableConfig = field(default_factory=TableConfig)
     """Table, hand, camera and physics settings."""
+    max_steps: int = 10
+    """Most behaviours per exploration episode (Algorithm 5 stops earlier once the object stops changing)."""
 
     def __post_init__(self) -> None:
         lo, hi = self.size_range
         if not (0.02 <= lo <= hi <= 0.6):
             raise ValueError(f"object sizes must satisfy 0.02 <= min <= max <= 0.6 m, got {lo} and {hi}")
+        if self.max_steps < 1:
+            raise ValueError(f"an episode needs at least one step, got max_steps {self.max_steps}")
         for s in self.shapes:
             if s not in SHAPES:
                 raise ValueError(f"unknown shape {s!r}; known shapes: {', '.join(SHAPES)}")
@@ -69,6 +76,15 @@ class TableScene:
     name = "table"
     behaviors = TABLE_BEHAVIORS
     summary = "a hand pushes and lifts one random object on a table (thesis chapter 8)"
+    labels = "discovered"
+    results: tuple[str, ...] = ()
+    loop = "play"
+    options = {
+        "size_min": "Smallest object dimension, metres (0.02-0.6).",
+        "size_max": "Largest object dimension, metres (0.02-0.6).",
+        "max_steps": "Most behaviours per episode.",
+    }
+    sample_options = ("objects", "reachable")
 
     def __init__(self, config: TableSceneConfig | None = None):
         self.config = config or TableSceneConfig()
@@ -83,6 +99,31 @@ class TableScene:
         d = asdict(self.config)
         d["name"] = self.name
         return d
+
+    def configure(self, size_min: float | None = None, size_max: float | None = None,
+                  max_steps: int | None = None) -> "TableScene":
+        """This scene with other object sizes or episode length (ValueError, one sentence, if bad)."""
+        c = self.config
+        lo = c.size_range[0] if size_min is None else float(size_min)
+        hi = c.size_range[1] if size_max is None else float(size_max)
+        if lo > hi:
+            raise ValueError(f"the smallest object size ({lo}) is larger than the largest ({hi})")
+        return type(self)(replace(c, size_range=(lo, hi), max_steps=c.max_steps if max_steps is None else int(max_steps)))
+
+    def sample(self, rng: np.random.Generator, objects: int = 1, reachable: bool = False) -> list[ObjectSpec]:
+        """A random layout: ``objects`` objects apart on the table (within reach if asked)."""
+        if objects == 1 and not reachable:
+            return [self.sample_object(rng)]
+        return self.sample_objects(rng, objects, reachable=reachable)
+
+    def parse_layout(self, text: str, source: str = "layout") -> list[ObjectSpec]:
+        return parse_layout(text, source)
+
+    def layout_toml(self, layout: list[ObjectSpec]) -> str:
+        return layout_toml(layout)
+
+    def layout_json(self, layout: list[ObjectSpec]) -> list[dict]:
+        return [s.to_dict() for s in layout]
 
     def sample_object(self, rng: np.random.Generator) -> ObjectSpec:
         c = self.config
