@@ -62,7 +62,7 @@ from functools import lru_cache
 import numpy as np
 
 from features.detect import RangeImage
-from features.schema import N_ANGLE_BINS, FeatureSchema
+from features.schema import Channel, N_ANGLE_BINS, FeatureSchema
 
 __all__ = [
     "GridSpec",
@@ -145,7 +145,10 @@ def _schema(spec: GridSpec) -> FeatureSchema:
                 prefix = f"l{layer}_r{row}_c{col}_"
                 names += [prefix + s for s, _ in suffixes]
                 channels += [c for _, c in suffixes]
-    return FeatureSchema(tuple(names), tuple(channels))
+    # The whole environment is the entity: it is always seen (no visibility feature).
+    return FeatureSchema(tuple(names), tuple(channels), visibility=None,
+                         histograms=tuple(grid_histogram_groups(spec)),
+                         channel_info=(Channel("range", "m", 0.05, 0.1), Channel("shape", "fraction", 0.1, 0.5)))
 
 
 def grid_schema(spec: GridSpec = GridSpec()) -> FeatureSchema:

@@ -252,8 +252,10 @@ def explore(
                 if total_rows >= interactions:
                     break
                 # Ask for about as many episodes as the rows still missing need, at the rate
-                # seen so far (about two rows an episode), so little is explored in vain.
-                rate = total_rows / next_episode if next_episode else 2.0
+                # seen so far (about two rows an episode at the table, every behaviour once
+                # in a scan), so little is explored in vain.
+                first_guess = len(scene.behaviors) if scene.loop == "scan" else 2.0  # a scan tries every behaviour
+                rate = total_rows / next_episode if next_episode else first_guess
                 need = max(workers * chunk, int((interactions - total_rows) / max(rate, 1.0)) + 1)
                 stop = next_episode + need
             jobs = (delayed(_run_chunk)(scene, seed, eps, max_steps) for eps in _chunks(next_episode, stop, chunk))

@@ -1,0 +1,1 @@
+"""Robots shared by the scenes: the chapter-5 mobile base (``sim.robots.mobile``)."""

@@ -1,0 +1,111 @@
+"""The mobile robot through the one command line: explore, inspect, learn with given labels, predict, refuse."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from afford_cli.app import app
+
+runner = CliRunner()
+TRAVERSE = ("traverse", "traverse-body", "traverse-gaps", "traverse-ramps")
+
+
+def ok(args):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, (args, result.output)
+    return result
+
+
+def fails(args, code=1):
+    result = runner.invoke(app, args)
+    assert result.exit_code == code, (args, result.output)
+    assert "Traceback" not in result.output
+    return result.output
+
+
+@pytest.fixture(scope="module")
+def learned(tmp_path_factory):
+    d = tmp_path_factory.mktemp("traverse")
+    ok(["explore", "--scene", "traverse", "--episodes", "36", "--seed", "5", "--workers", "2", "-o", str(d / "train.afford")])
+    ok(["explore", "--scene", "traverse", "--episodes", "8", "--seed", "6", "-o", str(d / "test.afford")])
+    ok(["select-features", str(d / "train.afford"), "-o", str(d / "features.afford")])
+    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
+    return d
+
+
+def test_the_traverse_scenes_are_listed_with_their_moves():
+    out = json.loads(ok(["scenes", "--json"]).stdout)
+    scenes = {s["name"]: s for s in out["scenes"]}
+    for name in TRAVERSE:
+        moves = scenes[name]["behaviors"]
+        assert len(moves) == 7 and all(m["target"] is None and m["parameters"] == [] for m in moves)
+        assert {m["name"] for m in moves} >= {"go-forward", "turn-left-60", "turn-right-20"}
+
+
+def test_exploration_records_given_results_on_3900_grid_features(learned):
+    info = json.loads(ok(["inspect", str(learned / "train.afford"), "--json"]).stdout)
+    assert len(info["features"]) == 3900 and info["label_source"] == "given"
+    assert {c["channel"]: c["n"] for c in info["channels"]} == {"range": 300, "shape": 3600}
+    assert info["visibility"] is None and info["histograms"] == 200
+    assert info["n_interactions"] == 36 * 7
+    rates = [r["success"] for r in info["result_rates"].values()]
+    assert len(rates) == 7 and 0.0 < min(rates) and max(rates) < 1.0  # neither all success nor all failure
+
+
+def test_an_environment_is_stored_once_for_its_seven_moves(learned):
+    from afford_cli.artifacts import read_artifact
+
+    art = read_artifact(str(learned / "train.afford"))
+    assert art.arrays["entities"].shape == (36, 3900) and art.arrays["entities"].dtype == np.float32
+    assert "after_index" not in art.arrays and art.arrays["result"].shape == (36 * 7,)
+
+
+def test_learning_with_given_results_needs_no_cluster_step(learned):
+    info = json.loads(ok(["inspect", str(learned / "model.afford"), "--json"]).stdout)
+    assert info["label_source"] == "given"
+    assert set(info["n_selected"]) == set(info["behavior_names"]) and max(info["n_selected"].values()) <= 3900
+    out = json.loads(ok(["evaluate", str(learned / "model.afford"), str(learned / "test.afford"), "--baselines",
+                         "--json"]).stdout)
+    for name, m in out["behaviors"].items():
+        assert m["n_test"] == 8 and 0.0 <= m["accuracy"] <= 1.0
+        assert {"majority", "random_forest"} <= set(m["baselines"])
+
+
+def test_predict_check_runs_every_move_from_the_same_start(learned):
+    out = json.loads(ok(["predict", str(learned / "model.afford"), "--scene", "traverse", "--seed", "4", "--check",
+                         "--json"]).stdout)
+    assert len(out["objects"]) == 1 and out["checked"] == 7 and out["label_source"] == "given"
+    for p in out["objects"][0]["behaviors"].values():
+        assert p["result"] in ("fail", "success") and p["observed_result"] in ("fail", "success")
+        assert abs(sum(p["probabilities"].values()) - 1) < 1e-3
+
+
+def test_commands_refuse_what_does_not_apply_in_one_sentence(learned, tmp_path):
+    model = str(learned / "model.afford")
+    assert "does not apply to scene 'traverse'" in fails(["explore", "--scene", "traverse", "--size-min", "0.1",
+                                                           "-o", str(tmp_path / "x")], code=2)
+    assert "--objects does not apply" in fails(["predict", model, "--scene", "traverse", "--seed", "1", "--objects", "2"],
+                                               code=2)
+    assert "nothing after its behaviours" in fails(["cluster", str(learned / "train.afford"), "-o", str(tmp_path / "x")])
+    assert "labels were given" in fails(["plan", model, "--scene", "traverse", "--seed", "1", "--goal", "*:l0_r0_c0_min=1"])
+    table = tmp_path / "table.toml"
+    table.write_text('[[object]]\nshape = "box"\nsize = [0.1, 0.1, 0.1]\nposition = [0.6, 0.0]\nheld = true\n')
+    assert "held" in fails(["predict", model, "--scene", "traverse", "--layout", str(table)])
+    ramp = tmp_path / "ramp.toml"
+    ramp.write_text("[[ramp]]\nposition = [0.6, 0.0]\nyaw = 0.0\nwidth = 1.0\nlength = 1.0\nslope = 10.0\n")
+    assert "unknown table 'ramp'" in fails(["predict", model, "--scene", "table", "--layout", str(ramp)])
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_goal_on_a_feature_the_schema_lacks_is_refused(learned):
+    from plan.goals import GoalError, parse_goal
+    from sim.registry import make_scene
+
+    schema = make_scene("traverse").schema
+    with pytest.raises(GoalError, match="unknown feature 'z_min'"):
+        parse_goal(["0:z_min=0.9"], schema)
+    assert parse_goal(["0:l0_r2_c2_min>1.5"], schema).holds(np.full((1, 3900), 2.0))

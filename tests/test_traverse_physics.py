@@ -1,0 +1,172 @@
+"""The chapter-5 robot in pinned traverse worlds: what blocks it, what it pushes, climbs and crosses.
+
+Every outcome here is PhysX's; the robot judges it from its own encoders and IMU.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sim.layout import LayoutError
+from sim.traverse import (
+    ROTATIONS, Gap, Item, Ramp, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout,
+    sample_body, sample_clutter, sample_gap, sample_ramp,
+)
+
+
+def go(layout: TraverseLayout, rotate: float = 0.0, seed: int = 0):
+    world = TraverseWorld(layout, np.random.default_rng(seed))
+    odometry = world.move(rotate)
+    return odometry, world.truth()
+
+
+def one(text: str) -> TraverseLayout:
+    return parse_layout(text, "test.toml")
+
+
+# -- objects ------------------------------------------------------------------------------------
+def test_a_heavy_box_in_the_path_blocks_going_forward():
+    odo, truth = go(one('[[object]]\nshape = "box"\nsize = [0.3, 0.3, 0.3]\nposition = [0.7, 0.0]\n'))
+    assert not odo.success
+    assert odo.displacement_m < 0.5
+    assert truth["contact"] and truth["touched_objects"] == [0]
+    assert truth["end"]["x"] < 0.45  # it really stopped at the box (ground truth agrees)
+
+
+def test_a_sphere_in_the_path_is_pushed_away_and_the_robot_traverses():
+    odo, truth = go(one('[[object]]\nshape = "sphere"\nsize = [0.25]\nposition = [0.6, 0.0]\n'))
+    assert odo.success
+    assert truth["contact"]
+    start, end = truth["objects"][0]["start"], truth["objects"][0]["end"]
+    assert end[0] - start[0] > 0.2
+
+
+def test_a_lying_cylinder_rolls_across_its_axis_but_not_along_it():
+    across, _ = go(TraverseLayout(items=(Item("lying-cylinder", (0.2, 0.6), (0.6, 0.0), yaw=90.0),)))
+    along, _ = go(TraverseLayout(items=(Item("lying-cylinder", (0.2, 0.6), (0.7, 0.0), yaw=0.0),)))
+    assert across.success
+    assert not along.success
+
+
+def test_a_box_hanging_below_the_robots_top_blocks_it_and_one_above_lets_it_pass():
+    low, low_truth = go(TraverseLayout(items=(Item("box", (0.2, 0.6, 0.1), (0.6, 0.0), z=0.40, fixed=True),)))
+    high, high_truth = go(TraverseLayout(items=(Item("box", (0.2, 0.6, 0.1), (0.6, 0.0), z=0.52, fixed=True),)))
+    assert not low.success and low_truth["contact"]
+    assert high.success and not high_truth["contact"]
+
+
+# -- ramps and gaps -----------------------------------------------------------------------------
+def test_a_gentle_ramp_head_on_is_climbed_and_a_steep_one_is_not():
+    gentle, gentle_truth = go(TraverseLayout(ramps=(Ramp((0.4, 0.0), 0.0, 1.0, 1.5, 5.0),)))
+    steep, _ = go(TraverseLayout(ramps=(Ramp((0.4, 0.0), 0.0, 1.0, 1.5, 25.0),)))
+    assert gentle.success
+    assert gentle_truth["end"]["z"] > 0.015  # it is up on the ramp
+    assert not steep.success
+
+
+def test_a_narrow_gap_is_crossed_and_a_wide_one_is_not():
+    narrow, narrow_truth = go(one("[[gap]]\ndistance = 0.1\nwidth = 0.08\n"))
+    wide, wide_truth = go(one("[[gap]]\ndistance = 0.1\nwidth = 0.40\n"))
+    assert narrow.success and not narrow_truth["fell"]
+    assert narrow_truth["end"]["x"] > 0.65
+    assert not wide.success
+    assert wide_truth["end"]["x"] < 0.5  # it fell in or stopped at the edge
+
+
+# -- the behaviours in an empty world -----------------------------------------------------------
+@pytest.mark.parametrize("rotate", ROTATIONS)
+def test_every_behaviour_succeeds_in_an_empty_world(rotate):
+    odo, truth = go(TraverseLayout(), rotate)
+    assert odo.success, odo
+    assert abs(truth["end"]["yaw"] - rotate) < 1.0
+    moved = math.hypot(truth["end"]["x"], truth["end"]["y"])
+    assert 0.65 <= moved <= 0.75
+    heading = math.degrees(math.atan2(truth["end"]["y"], truth["end"]["x"]))
+    assert abs(heading - rotate) < 5.0  # it drove off in the direction it turned to
+    assert not truth["contact"] and not truth["fell"]
+
+
+def test_odometry_is_the_robots_reading_not_ground_truth():
+    """Against a wall the encoders count where the robot really stopped (no wheel spin)."""
+    odo, truth = go(TraverseLayout(items=(Item("box", (0.2, 1.0, 0.5), (0.6, 0.0), fixed=True),)))
+    assert not odo.success
+    assert odo.travelled_m == pytest.approx(truth["end"]["x"], abs=0.02)
+
+
+# -- the scanner ---------------------------------------------------------------------------------
+def test_the_scan_of_an_empty_world_sees_the_floor_below_the_horizon_only():
+    image = TraverseWorld(TraverseLayout(), np.random.default_rng(0)).scan()
+    assert image.ranges.shape == (360, 360)
+    assert image.directions.shape == (360, 360, 3)
+    np.testing.assert_allclose(np.linalg.norm(image.directions, axis=-1), 1.0, atol=1e-6)
+    lower, upper = image.ranges[200:], image.ranges[:170]
+    assert np.isfinite(lower[:, 60:300]).mean() > 0.9
+    assert not np.isfinite(upper).any()
+    floor = image.points()[np.isfinite(image.ranges)]
+    assert np.abs(floor[:, 2]).max() < 0.03  # every hit lies on the floor (range noise 3 mm)
+
+
+def test_a_box_in_front_shows_nearer_ranges_in_the_image_centre():
+    empty = TraverseWorld(TraverseLayout(), np.random.default_rng(0)).scan()
+    box = TraverseWorld(TraverseLayout(items=(Item("box", (0.3, 0.3, 0.3), (1.0, 0.0)),)),
+                        np.random.default_rng(0)).scan()
+    centre = (slice(175, 230), slice(165, 195))
+    near, far = np.nan_to_num(box.ranges[centre], posinf=9.0), np.nan_to_num(empty.ranges[centre], posinf=9.0)
+    assert np.all(near <= far + 0.02)       # nothing got farther
+    assert (near < far - 0.1).sum() > 100   # the box's front face, much nearer than the floor behind it
+    assert near.min() < 0.9
+
+
+def test_the_same_seed_gives_byte_identical_scans_and_odometry():
+    layout = sample_clutter(np.random.default_rng(3))
+    a = TraverseWorld(layout, np.random.default_rng(11))
+    b = TraverseWorld(layout, np.random.default_rng(11))
+    assert a.scan().ranges.tobytes() == b.scan().ranges.tobytes()
+    oa = TraverseWorld(layout, np.random.default_rng(11)).move(20.0)
+    ob = TraverseWorld(layout, np.random.default_rng(11)).move(20.0)
+    assert oa == ob
+    assert sample_clutter(np.random.default_rng(3)) == layout
+
+
+# -- layouts ---------------------------------------------------------------------------------------
+def test_layouts_round_trip_through_toml():
+    layout = TraverseLayout(items=(Item("box", (0.1, 0.2, 0.3), (0.8, 0.1), 30.0),
+                                   Item("box", (0.1, 0.1, 0.1), (0.8, -0.3), 0.0, z=0.5, fixed=True)),
+                            ramps=(Ramp((0.6, 0.2), -20.0, 0.8, 1.2, 7.5),), gaps=(Gap(0.5, 0.2, 15.0),))
+    assert parse_layout(layout_toml(layout)) == layout
+    assert TraverseLayout.from_dict(layout.to_dict()) == layout
+
+
+@pytest.mark.parametrize("text, words", [
+    ('[[object]]\nshape = "cone"\nsize = [0.1]\nposition = [1, 0]\n', "object 0: unknown shape"),
+    ('[[object]]\nshape = "box"\nsize = [0.1]\nposition = [1, 0]\n', "object 0"),
+    ('[[object]]\nshape = "box"\nsize = [0.1, 0.1, 0.1]\nposition = [1, 0]\nz = 0.3\n', "fixed"),
+    ("[[ramp]]\nposition = [1, 0]\nslope = 80\n", "ramp 0"),
+    ("[[gap]]\ndistance = 0.3\n", "gap 0: missing 'width'"),
+    ("[[gap]]\ndistance = 0.3\nwidth = 0.1\n[[gap]]\ndistance = 0.8\nwidth = 0.1\n", "at most one gap"),
+    ("[[hole]]\nwidth = 1\n", "unknown table"),
+    ("[[gap]]\ndistance = 0.3\nwidth = 0.1\ncolour = 1\n", "unknown key 'colour'"),
+])
+def test_layout_mistakes_are_one_sentence_naming_file_and_entry(text, words):
+    with pytest.raises(LayoutError) as err:
+        parse_layout(text, "bad.toml")
+    message = str(err.value)
+    assert message.startswith("bad.toml") and words in message and "\n" not in message
+
+
+def test_check_layout_refuses_what_overlaps_the_robots_start():
+    with pytest.raises(ValueError, match="object 0"):
+        check_layout(TraverseLayout(items=(Item("box", (0.3, 0.3, 0.3), (0.2, 0.0)),)))
+    with pytest.raises(ValueError, match="gap 0"):
+        check_layout(TraverseLayout(gaps=(Gap(0.1, 0.2, 70.0),)))
+    check_layout(TraverseLayout(items=(Item("box", (0.3, 0.3, 0.1), (0.1, 0.0), z=0.6, fixed=True),)))
+
+
+@pytest.mark.parametrize("sampler", [sample_clutter, sample_body, sample_ramp, sample_gap])
+def test_sampled_layouts_are_valid_starts(sampler):
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        check_layout(sampler(rng))
