@@ -34,6 +34,7 @@ test: imports
 bench: $(STAMP)
 	$(PY) benchmarks/explore.py
 	$(PY) benchmarks/learn.py
+	$(PY) benchmarks/learn.py --scene traverse
 	$(PY) benchmarks/plan.py
 	$(PY) benchmarks/emulate.py
 

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+from enum import Enum
 from typing import Annotated, Optional
 
 import typer
 
 __all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives", "SceneSeed", "Objects",
-           "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source"]
+           "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source", "Kernel", "KernelOption"]
 
 Seed = Annotated[int, typer.Option("--seed", "-s", min=0, help="Random seed; the same seed gives the same arrays whatever --workers is.")]
 Workers = Annotated[int, typer.Option("--workers", "-w", min=1, max=64, help="Parallel worker processes.")]
@@ -19,6 +20,15 @@ Alternatives = Annotated[int, typer.Option(
     "--alternatives", min=1, max=10,
     help="Search this many of the most probable plans and take the one most likely to reach the goal with monitoring "
          "(each replan too); the others are reported. 1: the most probable plan, assessed alone.")]
+
+class Kernel(str, Enum):
+    rbf = "rbf"
+    linear = "linear"
+
+
+KernelOption = Annotated[Optional[Kernel], typer.Option(
+    "--kernel", help="SVM kernel; by default the scene's (linear for the traverse scenes, as in thesis chapter 5; RBF at the table).")]
+
 
 # -- where a command acts: a drawn scene or a pinned layout, and the planner's limits ------
 SceneSeed = Annotated[Optional[int], typer.Option("--seed", "-s", min=0, help="Draw a random scene from this seed.")]

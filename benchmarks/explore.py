@@ -1,11 +1,13 @@
-"""Exploration speed: interactions per second with 1 and 2 workers, and where the time goes.
+"""Exploration speed: interactions (and environments) per second with 1 and 2 workers, and where the time goes.
 
-    python benchmarks/explore.py [--interactions N] [--out benchmarks/results/explore.json]
+    python benchmarks/explore.py [--scenes table,traverse,...] [--interactions N] [--out benchmarks/results/explore.json]
 
 Prints one JSON object (and writes it to --out). The breakdown times one worker's
-episodes in this process by wrapping the four stages: world build, ray casting (Open3D),
-physics (PhysX steps, including contact queries) and features (detection, normals,
-histograms, tracking).
+episodes in this process by wrapping each stage. The table: world build, ray casting
+(Open3D), physics (PhysX steps, including contact queries) and features (detection,
+normals, histograms, tracking). The traverse scenes: world build, the scan (720 x 720
+rays cast with Open3D, noise, min-downscale), physics (the robot's moves) and the grid
+features.
 """
 
 from __future__ import annotations
@@ -24,9 +26,13 @@ from benchmarks._common import emit  # noqa: E402
 
 import features.objects as fobj  # noqa: E402
 import sim.camera as cam  # noqa: E402
+import sim.moves as moves  # noqa: E402
+import sim.robots.mobile as mobile  # noqa: E402
+import sim.scanner as scanner  # noqa: E402
+import sim.traverse as traverse  # noqa: E402
 import sim.world as world  # noqa: E402
 from sim.explore import explore, run_episode  # noqa: E402
-from sim.registry import get_scene  # noqa: E402
+from sim.registry import make_scene  # noqa: E402
 
 
 def throughput(scene, n: int, workers: int, seed: int) -> dict:
@@ -34,8 +40,46 @@ def throughput(scene, n: int, workers: int, seed: int) -> dict:
     start = time.perf_counter()
     data = explore(scene, interactions=n, seed=seed, workers=workers)
     seconds = time.perf_counter() - start
-    return {"workers": workers, "interactions": len(data), "seconds": round(seconds, 3),
-            "interactions_per_second": round(len(data) / seconds, 1)}
+    environments = int(np.unique(data.episode).size)
+    return {"workers": workers, "interactions": len(data), "environments": environments, "seconds": round(seconds, 3),
+            "interactions_per_second": round(len(data) / seconds, 1),
+            "environments_per_second": round(environments / seconds, 2)}
+
+
+def _patched(targets: list[tuple[object, str, str]], totals: dict):
+    """Wrap ``owner.attr`` so its time adds to ``totals[key]``; returns what to restore."""
+    saved = []
+    for owner, attr, key in targets:
+        fn = getattr(owner, attr)
+        saved.append((owner, attr, fn))
+
+        def wrapper(*a, _fn=fn, _key=key, **k):
+            t = time.perf_counter()
+            try:
+                return _fn(*a, **k)
+            finally:
+                totals[_key] += time.perf_counter() - t
+        setattr(owner, attr, wrapper)
+    return saved
+
+
+def traverse_breakdown(scene, episodes: int, seed: int) -> dict:
+    """Where one worker's time goes in a traverse scene, per interaction."""
+    totals = {"world_build": 0.0, "scan": 0.0, "physics": 0.0, "features": 0.0}
+    saved = _patched([(traverse.TraverseWorld, "__init__", "world_build"), (scanner.RangeScanner, "scan", "scan"),
+                      (mobile.MobileRobot, "move", "physics"), (moves, "grid_features", "features")], totals)
+    try:
+        start = time.perf_counter()
+        rows = sum(len(run_episode(scene, seed, e)) for e in range(episodes))
+        total = time.perf_counter() - start
+    finally:
+        for owner, attr, fn in saved:
+            setattr(owner, attr, fn)
+    out = {k: round(1000 * v / rows, 2) for k, v in totals.items()}
+    out["other"] = round(1000 * total / rows - sum(out.values()), 2)
+    env = {k: round(1000 * v / episodes, 1) for k, v in totals.items()}
+    return {"ms_per_interaction": out, "ms_per_environment": env, "interactions": rows, "environments": episodes,
+            "seconds": round(total, 3)}
 
 
 def breakdown(scene, episodes: int, seed: int) -> dict:
@@ -70,19 +114,35 @@ def breakdown(scene, episodes: int, seed: int) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--interactions", type=int, default=1000)
+    ap.add_argument("--interactions", type=int, default=1000, help="per throughput run on the table")
+    ap.add_argument("--traverse-interactions", type=int, default=700, help="per throughput run on a traverse scene")
+    ap.add_argument("--scenes", default="table,traverse,traverse-body,traverse-ramps,traverse-gaps")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "explore.json"))
     args = ap.parse_args()
-    scene = get_scene("table")()
+    names = [n for n in args.scenes.split(",") if n]
     result = {
         "benchmark": "explore",
         "machine": {"python": platform.python_version(), "cpus": __import__("os").cpu_count(),
                     "platform": platform.platform()},
+    }
+    for name in names:
+        if name == "table":
+            continue
+        sc = make_scene(name)
+        result[name] = {
+            "throughput": [throughput(sc, args.traverse_interactions, w, args.seed) for w in (1, 2)],
+            "breakdown_one_worker": traverse_breakdown(sc, episodes=20, seed=args.seed),
+        }
+    if "table" not in names:
+        emit(result, args.out)
+        return
+    scene = make_scene("table")
+    result.update({
         "throughput": [throughput(scene, args.interactions, w, args.seed) for w in (1, 2)],
         "breakdown_one_worker": breakdown(scene, episodes=max(20, args.interactions // 10), seed=args.seed),
         "features_alone_ms": None,
-    }
+    })
     # perception alone, on a typical range image
     rng = np.random.default_rng(0)
     w = scene.build([scene.sample_object(rng)], rng)

@@ -109,3 +109,22 @@ def test_a_goal_on_a_feature_the_schema_lacks_is_refused(learned):
     with pytest.raises(GoalError, match="unknown feature 'z_min'"):
         parse_goal(["0:z_min=0.9"], schema)
     assert parse_goal(["0:l0_r2_c2_min>1.5"], schema).holds(np.full((1, 3900), 2.0))
+
+
+EXAMPLES = {"box-ahead": "fail", "ball-ahead": "success", "bar-low": "fail", "bar-high": "success",
+            "ramp-gentle": "success", "ramp-steep": "fail", "gap-narrow": "success", "gap-wide": "fail"}
+
+
+@pytest.mark.parametrize("name", sorted(EXAMPLES))
+def test_the_example_layouts_do_what_their_comments_say(name):
+    from pathlib import Path
+
+    from afford_cli.scenes_io import open_world, scene_layout
+
+    path = Path(__file__).parents[1] / "examples" / "layouts" / "traverse" / f"{name}.toml"
+    scene, layout = scene_layout("traverse", None, str(path))
+    world = open_world(scene, layout, 0)
+    before = world.perceive()
+    after = world.act("go-forward", 0)
+    assert np.array_equal(before, after)  # nothing is perceived after a move: the start stays the entity
+    assert scene.results[world.last_result] == EXAMPLES[name]

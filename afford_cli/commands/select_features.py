@@ -10,8 +10,8 @@ import typer
 from rich.table import Table
 
 from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.learning import features_members, read_effects, read_rows
-from afford_cli.options import InputPath, Json, OutputPath, Seed
+from afford_cli.learning import features_members, learner_settings, read_effects, read_rows
+from afford_cli.options import InputPath, Json, KernelOption, OutputPath, Seed
 from afford_cli.output import Output
 
 
@@ -27,6 +27,7 @@ def select_features(
     method: Annotated[Method, typer.Option(help="ReliefF (Algorithm 3), forward selection (sequentialfs) or backward elimination (schemata search).")] = Method.relieff,
     top: Annotated[Optional[int], typer.Option("--top", min=1, help="Keep this many features, best first.")] = None,
     group_channels: Annotated[bool, typer.Option("--group-channels", help="Wrappers move each 18-bin histogram as one unit.")] = False,
+    kernel: KernelOption = None,
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
@@ -37,11 +38,12 @@ def select_features(
     out = Output(json, stdout_busy=output == "-")
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
+    kernel_name, _ = learner_settings(art, data, kernel.value if kernel is not None else None)
     start = time.perf_counter()
     with out.progress(f"selecting features ({method.value})", len(data.behaviors)) as update:
         relevance = rank_features(data, labels, method=method.value, top=top, seed=seed,
-                                  group_channels=group_channels, progress=update)
-    settings = {"method": method.value, "top": top, "group_channels": group_channels}
+                                  group_channels=group_channels, kernel=kernel_name, progress=update)
+    settings = {"method": method.value, "top": top, "group_channels": group_channels, "kernel": kernel_name}
     arrays, meta, blobs = features_members(art, data, relevance, settings)
     write_artifact(output, artifact_bytes("features", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     result = {"output": output, "seconds": round(time.perf_counter() - start, 3),

@@ -3,27 +3,22 @@
 from __future__ import annotations
 
 import time
-from enum import Enum
-from typing import Annotated
+from typing import Annotated, Optional
 
 import typer
 from rich.table import Table
 
 from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.learning import model_members, read_effects, read_rows, read_selection
-from afford_cli.options import InputPath, Json, OutputPath, Seed
+from afford_cli.learning import learner_settings, model_members, read_effects, read_rows, read_selection
+from afford_cli.options import InputPath, Json, KernelOption, OutputPath, Seed
 from afford_cli.output import Output
-
-
-class Kernel(str, Enum):
-    rbf = "rbf"
-    linear = "linear"
 
 
 def train(
     path: InputPath,
     output: OutputPath,
-    kernel: Annotated[Kernel, typer.Option(help="SVM kernel.")] = Kernel.rbf,
+    kernel: KernelOption = None,
+    folds: Annotated[Optional[int], typer.Option("--folds", min=2, max=10, help="Cross-validation folds that choose C (and gamma) and report accuracy; by default the scene's (5 for the traverse scenes, 3 at the table).")] = None,
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
@@ -35,11 +30,13 @@ def train(
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, effects = read_effects(art, data)
     selected = read_selection(art, data)
+    kernel_name, n_folds = learner_settings(art, data, kernel.value if kernel is not None else None, folds)
     start = time.perf_counter()
-    with out.progress(f"training predictors ({kernel.value} SVM)", len(data.behaviors)) as update:
-        predictors = train_predictors(data, labels, selected, kernel=kernel.value, seed=seed, progress=update)
+    with out.progress(f"training predictors ({kernel_name} SVM)", len(data.behaviors)) as update:
+        predictors = train_predictors(data, labels, selected, kernel=kernel_name, folds=n_folds, seed=seed,
+                                      progress=update)
     known = train_known(data, labels, seed=seed) if effects is not None else None
-    settings = {"kernel": kernel.value, "selection": art.kind}
+    settings = {"kernel": kernel_name, "folds": n_folds, "selection": art.kind}
     arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known)
     write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     result = {"output": output, "seconds": round(time.perf_counter() - start, 3),
