@@ -17,6 +17,7 @@ from afford_cli.commands import (
     cluster, demo, emulate, evaluate, explore, inspect, plan, predict, scenes, select_features, train,
 )
 from afford_cli.errors import AffordError
+from features.errors import DataError
 
 app = typer.Typer(
     name="afford",
@@ -34,10 +35,12 @@ def _guarded(command: Callable) -> Callable:
     def run(*args, **kwargs):
         try:
             return command(*args, **kwargs)
-        except (AffordError, ValueError, KeyError, OSError) as exc:
+        except (AffordError, DataError, OSError) as exc:
+            # afford's own errors (and the operating system's) are the user's to fix; anything
+            # else is a bug in afford and surfaces as one
             if os.environ.get("AFFORD_DEBUG") == "1":
                 raise
-            message = str(exc.args[0]) if isinstance(exc, KeyError) and exc.args else str(exc)
+            message = str(exc)
             sys.stderr.write(f"error: {message}\n")
             raise typer.Exit(1) from None
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from afford_cli.errors import AffordError
+from features.errors import DataError
 
 __all__ = ["make_scene", "scene_layout", "open_world", "layout_json"]
 
@@ -22,7 +23,7 @@ def make_scene(name: str, **options):
         raise AffordError(str(exc)) from None
     except SceneOptionError as exc:
         raise typer.BadParameter(str(exc)) from None
-    except ValueError as exc:
+    except DataError as exc:
         raise AffordError(f"scene {name!r}: {exc}") from None
 
 
@@ -56,11 +57,11 @@ def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_em
         rng = np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(7,)))
         try:
             specs = scene.sample(rng, **given)
-        except ValueError as exc:
+        except DataError as exc:
             raise AffordError(str(exc)) from None
     try:
         scene.check_layout(specs)
-    except ValueError as exc:
+    except DataError as exc:
         raise AffordError(f"{layout or 'the scene'}: {exc}") from None
     return scene, specs
 

@@ -63,6 +63,7 @@ import numpy as np
 
 from features.detect import RangeImage
 from features.schema import Channel, N_ANGLE_BINS, FeatureSchema
+from features.errors import DataError
 
 __all__ = [
     "GridSpec",
@@ -113,9 +114,9 @@ class GridSpec:
 
     def __post_init__(self) -> None:
         if self.cells < 1 or self.layers < 1 or self.normal_step < 1:
-            raise ValueError("a grid needs cells, layers and normal_step of at least 1")
+            raise DataError("a grid needs cells, layers and normal_step of at least 1")
         if not self.max_range > 0:
-            raise ValueError("max_range must be positive")
+            raise DataError("max_range must be positive")
 
     @property
     def n_cells(self) -> int:

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from features.schema import FeatureSchema
+from features.errors import DataError
 
 __all__ = ["Interactions", "OUTCOMES", "encode_parameters", "n_encoded"]
 
@@ -148,7 +149,7 @@ class Interactions:
     def after(self) -> np.ndarray:
         """f^(b) per row, (n, d)."""
         if self.after_index is None:
-            raise ValueError("these interactions record no entity after the behaviours (their labels are given), "
+            raise DataError("these interactions record no entity after the behaviours (their labels are given), "
                              "so they have no effects")
         return self.entities[self.after_index]
 
@@ -172,32 +173,32 @@ class Interactions:
         n = len(self)
         d = len(self.schema)
         if self.entities.ndim != 2 or self.entities.shape[1] != d:
-            raise ValueError(f"interactions have {self.entities.shape[-1]} features but the schema names {d}")
+            raise DataError(f"interactions have {self.entities.shape[-1]} features but the schema names {d}")
         if self.entities.dtype.kind != "f":
-            raise ValueError("the interactions' entity features are not numbers")
+            raise DataError("the interactions' entity features are not numbers")
         m = self.entities.shape[0]
         for name in self.ARRAYS + (("after_index",) if self.after_index is not None else ()) + (
                 ("result",) if self.result is not None else ()):
             arr = getattr(self, name)
             if arr.ndim < 1 or arr.shape[0] != n:
-                raise ValueError(f"interactions array {name!r} has {arr.shape[0] if arr.ndim else 0} rows, expected {n}")
+                raise DataError(f"interactions array {name!r} has {arr.shape[0] if arr.ndim else 0} rows, expected {n}")
             if arr.dtype.kind not in "iuf" or (name != "params" and arr.dtype.kind == "f"):
-                raise ValueError(f"interactions array {name!r} does not hold integers")
+                raise DataError(f"interactions array {name!r} does not hold integers")
         for name in ("before_index", "after_index"):
             idx = getattr(self, name)
             if idx is not None and n and (idx.min() < 0 or idx.max() >= m):
-                raise ValueError(f"interactions array {name!r} points outside the {m} stored entities")
+                raise DataError(f"interactions array {name!r} points outside the {m} stored entities")
         if self.params.ndim != 2:
-            raise ValueError("interactions array 'params' must be a table (rows x parameters)")
+            raise DataError("interactions array 'params' must be a table (rows x parameters)")
         for name, arr in self.truth.items():
             if arr.ndim < 1 or arr.shape[0] != n:
-                raise ValueError(f"ground-truth array {name!r} has the wrong number of rows, expected {n}")
+                raise DataError(f"ground-truth array {name!r} has the wrong number of rows, expected {n}")
         if n and (self.behavior.min() < 0 or self.behavior.max() >= len(self.behaviors)):
-            raise ValueError("an interaction names a behaviour the file does not list")
+            raise DataError("an interaction names a behaviour the file does not list")
         if self.result is not None and n and (self.result.min() < 0 or self.result.max() >= len(self.result_names)):
-            raise ValueError("an interaction's result is not one of the results the file lists")
+            raise DataError("an interaction's result is not one of the results the file lists")
         if not np.isfinite(self.entities).all():
-            raise ValueError("the interactions hold NaN or infinite features")
+            raise DataError("the interactions hold NaN or infinite features")
 
     def subset(self, rows: np.ndarray) -> "Interactions":
         """These rows only (the entity table is shared, not copied)."""

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from features.errors import DataError, NameNotFound
 
 __all__ = ["Channel", "FeatureSchema", "object_schema", "AXES", "N_ANGLE_BINS"]
 
@@ -89,17 +90,17 @@ class FeatureSchema:
 
     def __post_init__(self) -> None:
         if len(self.names) != len(self.channels):
-            raise ValueError("a schema needs one channel per feature name")
+            raise DataError("a schema needs one channel per feature name")
         if len(set(self.names)) != len(self.names):
-            raise ValueError("feature names in a schema must be unique")
+            raise DataError("feature names in a schema must be unique")
         if self.visibility is not None and self.visibility not in self.names:
-            raise ValueError(f"the visibility feature {self.visibility!r} is not among the schema's features")
+            raise DataError(f"the visibility feature {self.visibility!r} is not among the schema's features")
         for a, b in self.histograms:
             if not (isinstance(a, int) and isinstance(b, int) and 0 <= a < b <= len(self.names)):
-                raise ValueError(f"histogram columns {a}..{b} lie outside the schema's {len(self.names)} features")
+                raise DataError(f"histogram columns {a}..{b} lie outside the schema's {len(self.names)} features")
         for role, name in self.roles:
             if name not in self.names:
-                raise ValueError(f"the {role} feature {name!r} is not among the schema's features")
+                raise DataError(f"the {role} feature {name!r} is not among the schema's features")
         # one order for equal meanings (files store these as JSON objects, keys sorted)
         order = {ch: i for i, ch in enumerate(dict.fromkeys(self.channels))}
         object.__setattr__(self, "channel_info", tuple(sorted(self.channel_info, key=lambda c: order.get(c.name, len(order)))))
@@ -125,7 +126,7 @@ class FeatureSchema:
         try:
             return self._channel_index[channel]
         except KeyError:
-            raise KeyError(f"no channel named {channel!r}; the schema has {', '.join(self.channel_names)}") from None
+            raise NameNotFound(f"no channel named {channel!r}; the schema has {', '.join(self.channel_names)}") from None
 
     def channel(self, name: str) -> Channel:
         """Unit, tolerance and scale of channel ``name``."""
@@ -203,7 +204,7 @@ class FeatureSchema:
         try:
             return self._name_index[name]
         except KeyError:
-            raise KeyError(f"no feature named {name!r} in this schema") from None
+            raise NameNotFound(f"no feature named {name!r} in this schema") from None
 
     @cached_property
     def _name_index(self) -> dict[str, int]:
@@ -232,7 +233,7 @@ class FeatureSchema:
                 return legacy
             return cls(names, channels)
         if not isinstance(doc, dict) or not isinstance(doc.get("features"), list):
-            raise ValueError("the feature schema is malformed")
+            raise DataError("the feature schema is malformed")
         items = doc["features"]
         info = doc.get("channels") or {}
         return cls(

@@ -23,6 +23,7 @@ from features.interactions import encode_parameters
 from learn.effects import EffectCategories
 from learn.predictors import AffordancePredictor
 from learn.relevance import FeatureRelevance, feature_groups
+from features.errors import DataError
 
 __all__ = [
     "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",
@@ -59,9 +60,9 @@ def predictor_inputs(before: np.ndarray, params: np.ndarray, selected: np.ndarra
 def _check_rows(data: Interactions, b: int, rows: np.ndarray, what: str) -> None:
     name = data.behavior_names[b]
     if rows.size == 0:
-        raise ValueError(f"the data hold no interactions of behaviour {name!r}; explore more before {what}")
+        raise DataError(f"the data hold no interactions of behaviour {name!r}; explore more before {what}")
     if rows.size < MIN_ROWS:
-        raise ValueError(f"behaviour {name!r} has only {rows.size} usable interactions; {what} needs at least {MIN_ROWS}")
+        raise DataError(f"behaviour {name!r} has only {rows.size} usable interactions; {what} needs at least {MIN_ROWS}")
 
 
 def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max: int = 5, k: int | None = None,
@@ -103,7 +104,7 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
         _check_rows(data, b, rows, "feature selection")
         y = labels[rows]
         if np.unique(y).size < 2:
-            raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to tell apart")
+            raise DataError(f"behaviour {name!r} has one effect category only; there is nothing to tell apart")
         fr = FeatureRelevance(method=method, top=top, feature_groups=groups, random_state=behaviour_seed(seed, b),
                               estimator=prefix_estimator(kernel) if method == "relieff" else None)
         out[name] = fr.fit(data.before_rows(rows), y)
@@ -124,7 +125,7 @@ def prefix_estimator(kernel: str):
     from sklearn.preprocessing import StandardScaler
     from sklearn.svm import LinearSVC
 
-    return make_pipeline(StandardScaler(), LinearSVC(C=0.01, dual=False))
+    return make_pipeline(StandardScaler(), LinearSVC(C=0.01, dual=False, max_iter=20000))
 
 
 def train_known(data: Interactions, labels: np.ndarray, *, seed: int = 0, min_rows: int = 10) -> dict:
@@ -172,7 +173,7 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
         _check_rows(data, b, rows, "training")
         y = labels[rows]
         if np.unique(y).size < 2:
-            raise ValueError(f"behaviour {name!r} has one effect category only; there is nothing to predict")
+            raise DataError(f"behaviour {name!r} has one effect category only; there is nothing to predict")
         X = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b))
         out[name] = AffordancePredictor(kernel=kernel, cv=folds, n_jobs=n_jobs,
                                         random_state=behaviour_seed(seed, b)).fit(X, y)

@@ -44,6 +44,7 @@ from sklearn.utils.validation import check_array, check_is_fitted
 from features.schema import FeatureSchema
 from learn.validation import check_finite
 from learn.xmeans import XMeans
+from features.errors import DataError
 
 __all__ = ["EffectCategories"]
 
@@ -59,13 +60,13 @@ def _default_predictability_estimator():
 def _channels_of(schema, n_features: int) -> list[tuple[str, np.ndarray]]:
     """(channel, column indices) in order of first appearance."""
     if schema is None:
-        raise ValueError(
+        raise DataError(
             "EffectCategories needs schema= (a FeatureSchema or one channel name per effect column) "
             "to know the channels."
         )
     channels = tuple(schema.channels) if isinstance(schema, FeatureSchema) else tuple(str(c) for c in schema)
     if len(channels) != n_features:
-        raise ValueError(f"E has {n_features} features, but the schema names {len(channels)}.")
+        raise DataError(f"E has {n_features} features, but the schema names {len(channels)}.")
     arr = np.asarray(channels)
     return [(ch, np.flatnonzero(arr == ch)) for ch in dict.fromkeys(channels)]
 
@@ -243,15 +244,15 @@ class EffectCategories(BaseEstimator):
         self.n_features_in_ = d
         if self.prune == "predictability":
             if X is None:
-                raise ValueError(
+                raise DataError(
                     "prune='predictability' needs the initial object features: call fit(E, X)."
                 )
             X = check_array(X, dtype=np.float64, ensure_all_finite=False, input_name="X")
             check_finite(X, "X")
             if X.shape[0] != n:
-                raise ValueError(f"X has {X.shape[0]} rows but E has {n}; they must describe the same interactions.")
+                raise DataError(f"X has {X.shape[0]} rows but E has {n}; they must describe the same interactions.")
         if self.method == "kmeans" and self.k is not None and self.k > n:
-            raise ValueError(f"k={self.k} clusters cannot be found in {n} effects.")
+            raise DataError(f"k={self.k} clusters cannot be found in {n} effects.")
         rng = check_random_state(self.random_state)
 
         if self.method == "hierarchical":
@@ -328,7 +329,7 @@ class EffectCategories(BaseEstimator):
                 keep[:] = True
         kept = np.flatnonzero(keep)
         if kept.size == 0:
-            raise ValueError(
+            raise DataError(
                 "no effect category survived pruning; lower min_fraction or "
                 "predictability_threshold, or collect more interactions."
             )
@@ -436,7 +437,7 @@ class EffectCategories(BaseEstimator):
         E = check_array(E, dtype=np.float64, ensure_all_finite=False, input_name="E")
         check_finite(E, "E")
         if E.shape[1] != self.n_features_in_:
-            raise ValueError(
+            raise DataError(
                 f"E has {E.shape[1]} features, but EffectCategories is expecting "
                 f"{self.n_features_in_} features as input."
             )

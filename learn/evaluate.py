@@ -16,6 +16,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
 
 from learn.validation import check_finite
+from features.errors import DataError
 
 __all__ = ["baseline_scores", "evaluate_predictions", "reliability_bins"]
 
@@ -128,12 +129,12 @@ def _check_predictions(y_true, proba, classes) -> tuple[np.ndarray, np.ndarray, 
     proba = np.asarray(proba, dtype=np.float64)
     classes = np.asarray(classes)
     if proba.ndim != 2 or proba.shape != (y_true.shape[0], classes.shape[0]):
-        raise ValueError(
+        raise DataError(
             f"proba must have one row per label and one column per class: got shape {proba.shape} "
             f"for {y_true.shape[0]} labels and {classes.shape[0]} classes."
         )
     if y_true.shape[0] == 0:
-        raise ValueError("there is nothing to evaluate: y_true is empty.")
+        raise DataError("there is nothing to evaluate: y_true is empty.")
     check_finite(proba, "proba")
     return y_true, proba, classes
 
@@ -148,7 +149,7 @@ def _top_class(y_true, proba, classes):
 
 def _calibration_bins(confidence: np.ndarray, correct: np.ndarray, n_bins: int) -> list[dict]:
     if int(n_bins) != n_bins or n_bins < 1:
-        raise ValueError(f"n_bins must be a positive integer, got {n_bins!r}.")
+        raise DataError(f"n_bins must be a positive integer, got {n_bins!r}.")
     n_bins = int(n_bins)
     index = np.clip((confidence * n_bins).astype(int), 0, n_bins - 1)
     out = []
@@ -184,14 +185,14 @@ def baseline_scores(X_train, y_train, X_test, y_test, random_state=None) -> dict
     check_finite(X_train, "X_train")
     check_finite(X_test, "X_test")
     if X_train.ndim != 2 or X_test.ndim != 2 or X_train.shape[1] != X_test.shape[1]:
-        raise ValueError(
+        raise DataError(
             f"X_train and X_test must be 2-D with the same number of features: got shapes "
             f"{X_train.shape} and {X_test.shape}."
         )
     if y_train.shape[0] != X_train.shape[0] or y_test.shape[0] != X_test.shape[0]:
-        raise ValueError("each of X_train and X_test needs one label per row.")
+        raise DataError("each of X_train and X_test needs one label per row.")
     if y_train.shape[0] == 0 or y_test.shape[0] == 0:
-        raise ValueError("baselines need training and test rows; one of the sets is empty.")
+        raise DataError("baselines need training and test rows; one of the sets is empty.")
     values, counts = np.unique(y_train, return_counts=True)
     majority = values[np.argmax(counts)]
     knn = make_pipeline(StandardScaler(), KNeighborsClassifier(n_neighbors=min(5, y_train.shape[0])))

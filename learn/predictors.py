@@ -40,6 +40,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from learn.validation import check_finite
+from features.errors import DataError
 
 __all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
 
@@ -172,7 +173,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         singleton = counts[y_idx] == 1
         rows = np.flatnonzero(~singleton)
         if rows.size < self.cv:
-            raise ValueError(
+            raise DataError(
                 f"y has {y_idx.size} rows, too few to cross-validate with cv={self.cv}: at least "
                 f"{self.cv} rows must belong to categories with two or more members."
             )
@@ -222,7 +223,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         check_classification_targets(y)
         self.classes_, y_idx = np.unique(y, return_inverse=True)
         if self.classes_.size < 2:
-            raise ValueError(
+            raise DataError(
                 "AffordancePredictor needs at least two effect categories to learn from, "
                 f"but y holds only one class ({self.classes_[0]!r})."
             )
@@ -235,7 +236,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
             svc = OneVsRestClassifier(SVC(kernel="rbf"))
             prefix = "svc__estimator__"
         else:  # liblinear's primal solver: seconds faster than libsvm's linear kernel at large C
-            svc = LinearSVC(dual=False)
+            svc = LinearSVC(dual=False, max_iter=20000)
             prefix = "svc__"
         base = Pipeline([("scale", StandardScaler()), ("svc", svc)])
         grid = {prefix + "C": [float(c) for c in (self.C_grid if self.C_grid is not None else _C_GRID[self.kernel])]}

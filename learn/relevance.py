@@ -40,6 +40,7 @@ from sklearn.utils.validation import check_array, check_is_fitted, validate_data
 
 from features.schema import FeatureSchema
 from learn.validation import check_finite
+from features.errors import DataError
 
 __all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "ranking_prefix", "relieff"]
 
@@ -52,13 +53,13 @@ def _check_Xy(X, y, min_rows: int = 2):
     check_finite(X)
     y = np.asarray(y)
     if y.ndim != 1 or y.shape[0] != X.shape[0]:
-        raise ValueError(f"y must be one label per row of X: X has {X.shape[0]} rows, y has shape {y.shape}.")
+        raise DataError(f"y must be one label per row of X: X has {X.shape[0]} rows, y has shape {y.shape}.")
     check_classification_targets(y)
     classes, y_idx = np.unique(y, return_inverse=True)
     if classes.size < 2:
-        raise ValueError(f"feature relevance needs at least two effect categories, but y holds only one class ({classes[0]!r}).")
+        raise DataError(f"feature relevance needs at least two effect categories, but y holds only one class ({classes[0]!r}).")
     if X.shape[0] < min_rows:
-        raise ValueError(f"X has {X.shape[0]} rows, too few to estimate feature relevance (need at least {min_rows}).")
+        raise DataError(f"X has {X.shape[0]} rows, too few to estimate feature relevance (need at least {min_rows}).")
     return X, y, classes, y_idx
 
 
@@ -115,7 +116,7 @@ def relieff(X, y, n_samples=1000, n_neighbors=10, random_state=None) -> np.ndarr
     """
     X, y, classes, y_idx = _check_Xy(X, y)
     if n_samples < 1 or n_neighbors < 1:
-        raise ValueError("n_samples and n_neighbors must be at least 1.")
+        raise DataError("n_samples and n_neighbors must be at least 1.")
     rng = check_random_state(random_state)
     n, d = X.shape
     span = X.max(axis=0) - X.min(axis=0)
@@ -152,7 +153,7 @@ def _units(groups, d: int) -> list[np.ndarray]:
         return [np.array([j]) for j in range(d)]
     groups = np.asarray(groups)
     if groups.shape != (d,):
-        raise ValueError(f"feature groups must give one group per feature: X has {d} features, groups has shape {groups.shape}.")
+        raise DataError(f"feature groups must give one group per feature: X has {d} features, groups has shape {groups.shape}.")
     return [np.flatnonzero(groups == g) for g in dict.fromkeys(groups.tolist())]
 
 
@@ -254,7 +255,7 @@ def _evaluator(estimator, X, y, cv, random_state, n_jobs):
 def _folds(y, cv, seed):
     n = y.shape[0]
     if n < 2 * cv:
-        raise ValueError(f"X has {n} rows, too few to cross-validate with cv={cv} (need at least {2 * cv}).")
+        raise DataError(f"X has {n} rows, too few to cross-validate with cv={cv} (need at least {2 * cv}).")
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="The least populated class")
         return list(StratifiedKFold(cv, shuffle=True, random_state=seed).split(np.zeros(n), y))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from features.errors import DataError
 
 __all__ = ["check_finite"]
 
@@ -13,7 +14,7 @@ def check_finite(X: np.ndarray, what: str = "X") -> None:
     if not finite.all():
         bad = np.argwhere(~finite)[0]
         where = f"row {bad[0]}" + (f", column {bad[1]}" if bad.size > 1 else "")
-        raise ValueError(
+        raise DataError(
             f"{what} contains NaN or infinite values (first at {where}); "
             "drop or repair those rows before learning."
         )

@@ -35,6 +35,7 @@ from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from learn.validation import check_finite
+from features.errors import DataError
 
 __all__ = ["XMeans", "bic_score"]
 
@@ -165,7 +166,7 @@ class XMeans(ClusterMixin, BaseEstimator):
         check_finite(X)
         X = np.asarray(X, dtype=np.float64)
         if self.k_min > self.k_max:
-            raise ValueError(f"k_min={self.k_min} is larger than k_max={self.k_max}.")
+            raise DataError(f"k_min={self.k_min} is larger than k_max={self.k_max}.")
         rng = check_random_state(self.random_state)
 
         def seed():

@@ -13,6 +13,7 @@ import numpy as np
 
 from features import FeatureSchema
 from plan.goals import Constraint, Goal
+from features.errors import DataError
 
 __all__ = ["goal_from_observation"]
 
@@ -31,7 +32,7 @@ def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: Featu
     """
     needed = ("x_min", "x_max", "y_min", "y_max", "z_min")
     if schema.visibility_index is None or any(n not in schema.names for n in needed):
-        raise ValueError("emulation is chapter 8's: it needs entities that can vanish and have x, y and z extents, "
+        raise DataError("emulation is chapter 8's: it needs entities that can vanish and have x, y and z extents, "
                          "which this model's features do not have")
     seen = observed[schema.visible(observed)] if observed.size else observed.reshape(0, len(schema))
     k = start.shape[0]
@@ -55,7 +56,7 @@ def goal_from_observation(observed: np.ndarray, start: np.ndarray, schema: Featu
         out.append(c("*", "z_min", float(f[schema.index("z_min")]), 1.5 * tolerance))
         return Goal(tuple(out))
     if k < 2:
-        raise ValueError("the shown scene relates two objects, but the start scene has fewer than two")
+        raise DataError("the shown scene relates two objects, but the start scene has fewer than two")
     # Two (or more) shown: keep the relation of the first two, on the table plane.
     a, b = seen[0], seen[1]
     out = []

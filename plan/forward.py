@@ -19,6 +19,7 @@ from itertools import product
 import numpy as np
 
 from features import encode_parameters
+from features.errors import DataError
 
 __all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE"]
 
@@ -103,7 +104,7 @@ class ForwardModel:
         try:
             return self.names.index(name)
         except ValueError:
-            raise ValueError(f"unknown behaviour {name!r}; the model knows {', '.join(self.names)}") from None
+            raise DataError(f"unknown behaviour {name!r}; the model knows {', '.join(self.names)}") from None
 
     @property
     def predicts_effects(self) -> bool:
@@ -192,7 +193,7 @@ class ForwardModel:
         """Entity ``before`` after category ``category`` of behaviour ``b`` (vanished: last seen, visibility 0)."""
         prototypes = self.behaviors[b].prototypes
         if prototypes is None:
-            raise ValueError(f"behaviour {self.names[b]!r} has no effect prototypes (its labels were given), "
+            raise DataError(f"behaviour {self.names[b]!r} has no effect prototypes (its labels were given), "
                              "so the next state cannot be predicted")
         f = before + prototypes[category]
         v = self.visibility

@@ -17,6 +17,7 @@ from functools import cached_property
 import numpy as np
 
 from features import FeatureSchema
+from features.errors import DataError
 
 __all__ = ["Constraint", "Goal", "parse_goal", "GoalError"]
 
@@ -24,7 +25,7 @@ _EXPR = re.compile(r"^\s*(?P<obj>\*|\d+|\d+\s*-\s*\d+)\s*:\s*(?P<feat>[A-Za-z_][
                    r"\s*(~\s*(?P<rng>[-+]?(?:[\d.eE+-]+|nan|inf)))?\s*$", re.IGNORECASE)
 
 
-class GoalError(ValueError):
+class GoalError(DataError):
     """A goal expression that cannot be used."""
 
 

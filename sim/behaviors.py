@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from features.objects import extents
+from features.errors import DataError
 
 if TYPE_CHECKING:
     from sim.world import TableWorld
@@ -95,7 +96,7 @@ class Behavior:
     def __call__(self, world, target: np.ndarray | None, alpha: np.ndarray | None = None) -> Execution:
         alpha = np.zeros(0) if alpha is None else np.asarray(alpha, dtype=float)
         if alpha.shape != (len(self.parameters),):
-            raise ValueError(f"{self.name} takes {len(self.parameters)} parameter(s), got {alpha.size}")
+            raise DataError(f"{self.name} takes {len(self.parameters)} parameter(s), got {alpha.size}")
         return self.controller(world, target, alpha)
 
 

@@ -28,6 +28,7 @@ from features import Interactions
 from features.interactions import OUTCOMES
 from sim.objects import SHAPES
 from sim.world import ObjectTruth, TableWorld
+from features.errors import DataError
 
 __all__ = ["explore", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
            "MOVED", "LIFTED"]
@@ -235,7 +236,7 @@ def explore(
     many rows, in episode order, so it too is the same for any number of workers.
     """
     if (episodes is None) == (interactions is None):
-        raise ValueError("give either episodes or interactions")
+        raise DataError("give either episodes or interactions")
     from joblib import Parallel, delayed
 
     parts: list[Interactions] = []

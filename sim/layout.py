@@ -17,6 +17,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+from features.errors import DataError
 from sim.objects import SHAPES, ObjectSpec
 
 __all__ = ["LayoutError", "parse_layout", "load_layout", "layout_toml"]
@@ -24,7 +25,7 @@ __all__ = ["LayoutError", "parse_layout", "load_layout", "layout_toml"]
 _KEYS = {"shape", "size", "position", "yaw", "held"}
 
 
-class LayoutError(ValueError):
+class LayoutError(DataError):
     """A layout file that cannot be used."""
 
 

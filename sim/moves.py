@@ -24,6 +24,7 @@ import numpy as np
 from features.grid import GridSpec, grid_features, grid_schema
 from sim.behaviors import Behavior, Execution
 from sim.traverse import ROTATIONS, TraverseConfig, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout
+from features.errors import DataError
 
 __all__ = ["MOVES", "RESULTS", "TraverseScene", "TraverseSceneConfig", "ScanningWorld", "move_name"]
 
@@ -154,7 +155,7 @@ class TraverseScene:
 
     def check_layout(self, layout: TraverseLayout) -> None:
         if not isinstance(layout, TraverseLayout):
-            raise ValueError(f"that is not a layout of scene {self.name!r}")
+            raise DataError(f"that is not a layout of scene {self.name!r}")
         check_layout(layout, self.config.world.robot)
 
     def build(self, layout: TraverseLayout, rng: np.random.Generator) -> ScanningWorld:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import open3d as o3d
 import sapien
+from features.errors import DataError
 
 __all__ = ["SHAPES", "ObjectSpec", "build_object", "object_mesh", "yaw_quaternion"]
 
@@ -58,16 +59,16 @@ class ObjectSpec:
 
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
-            raise ValueError(f"unknown shape {self.shape!r}; known shapes: {', '.join(SHAPES)}")
+            raise DataError(f"unknown shape {self.shape!r}; known shapes: {', '.join(SHAPES)}")
         want = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}[self.shape]
         if len(self.size) != want:
-            raise ValueError(f"a {self.shape} needs {want} size value(s), got {len(self.size)}")
+            raise DataError(f"a {self.shape} needs {want} size value(s), got {len(self.size)}")
         if any(not (0.01 <= s <= 1.0) for s in self.size):
-            raise ValueError(f"object sizes must be between 0.01 and 1.0 m, got {list(self.size)}")
+            raise DataError(f"object sizes must be between 0.01 and 1.0 m, got {list(self.size)}")
         if len(self.position) != 2:
-            raise ValueError("an object's position is [x, y] on the table")
+            raise DataError("an object's position is [x, y] on the table")
         if not all(math.isfinite(v) for v in (*self.size, *self.position, self.yaw)):
-            raise ValueError("an object's size, position and yaw must be finite numbers")
+            raise DataError("an object's size, position and yaw must be finite numbers")
 
     @property
     def extents(self) -> np.ndarray:

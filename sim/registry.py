@@ -7,6 +7,7 @@ Importing ``sim.scenes`` registers every scene in it. ``get_scene`` raises
 from __future__ import annotations
 
 from typing import Callable, TypeVar
+from features.errors import DataError, NameNotFound
 
 __all__ = ["register_scene", "get_scene", "scene_names", "make_scene", "SceneNotFound"]
 
@@ -14,15 +15,14 @@ _SCENES: dict[str, type] = {}
 T = TypeVar("T", bound=type)
 
 
-class SceneNotFound(KeyError):
-    def __str__(self) -> str:  # KeyError quotes its message otherwise
-        return str(self.args[0])
+class SceneNotFound(NameNotFound):
+    """No scene is registered by that name."""
 
 
 def register_scene(name: str) -> Callable[[T], T]:
     def wrap(cls: T) -> T:
         if name in _SCENES and _SCENES[name] is not cls:
-            raise ValueError(f"a scene named {name!r} is registered already")
+            raise DataError(f"a scene named {name!r} is registered already")
         cls.name = name  # type: ignore[attr-defined]
         _SCENES[name] = cls
         return cls

@@ -29,6 +29,7 @@ import open3d as o3d
 
 from features import RangeImage
 from sim.camera import MeshInstance
+from features.errors import DataError
 
 __all__ = ["ScannerConfig", "RangeScanner", "scan_directions"]
 
@@ -52,7 +53,7 @@ class ScannerConfig:
 
     def __post_init__(self) -> None:
         if self.downscale < 1 or self.rows % self.downscale or self.cols % self.downscale:
-            raise ValueError(f"the scanner's {self.rows} x {self.cols} rays do not split into "
+            raise DataError(f"the scanner's {self.rows} x {self.cols} rays do not split into "
                              f"{self.downscale} x {self.downscale} blocks")
 
 

@@ -33,6 +33,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from features.errors import DataError
 from sim.layout import LayoutError
 
 __all__ = ["Scene", "SceneOptionError", "load_layout_file", "LOOPS", "LABEL_SOURCES"]
@@ -41,7 +42,7 @@ LOOPS = ("play", "scan")
 LABEL_SOURCES = ("discovered", "given")
 
 
-class SceneOptionError(ValueError):
+class SceneOptionError(DataError):
     """An option that does not apply to a scene (a usage error)."""
 
 

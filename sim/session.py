@@ -15,6 +15,7 @@ import numpy as np
 from dataclasses import dataclass
 
 from sim.explore import Step, interact
+from features.errors import DataError
 
 __all__ = ["SimWorld", "Trial"]
 
@@ -66,7 +67,7 @@ class SimWorld:
         """Run ``behavior`` on tracked object ``target`` (any, for a behaviour without a
         target); return what is perceived after."""
         if behavior not in self._behaviors:
-            raise ValueError(f"unknown behaviour {behavior!r}; this scene has {', '.join(self._behaviors)}")
+            raise DataError(f"unknown behaviour {behavior!r}; this scene has {', '.join(self._behaviors)}")
         b = self._behaviors[behavior]
         if self.scene.loop == "scan":
             world = self.scene.build(self.layout, self.rng)  # every behaviour from the same start
@@ -75,7 +76,7 @@ class SimWorld:
                                       world.truth_row()))
             return self.perceive()
         if not 0 <= target < self.state.shape[0]:
-            raise ValueError(f"there is no object {target}; the robot sees {self.state.shape[0]}")
+            raise DataError(f"there is no object {target}; the robot sees {self.state.shape[0]}")
         step = interact(self.world, self._behaviors[behavior], target, alpha, before=self.state)
         self.history.append(step)
         self.state = step.after

@@ -71,6 +71,7 @@ from sim.layout import LayoutError
 from sim.objects import SHAPES, ObjectSpec, build_object, object_mesh, yaw_quaternion
 from sim.robots.mobile import MobileRobot, MobileRobotConfig, Odometry
 from sim.scanner import RangeScanner, ScannerConfig
+from features.errors import DataError
 
 __all__ = [
     "Item", "Ramp", "Gap", "TraverseLayout", "TraverseConfig", "TraverseWorld", "ROTATIONS",
@@ -110,14 +111,14 @@ class Item:
         object.__setattr__(self, "size", tuple(float(v) for v in self.size))
         object.__setattr__(self, "position", tuple(float(v) for v in self.position))
         if len(self.position) != 2:
-            raise ValueError("an object's position is [x, y] of its centre, ahead and to the left of the robot")
+            raise DataError("an object's position is [x, y] of its centre, ahead and to the left of the robot")
         self.spec  # validates shape and size  # noqa: B018
         if not _finite(self.yaw) or (self.z is not None and not _finite(self.z)):
-            raise ValueError("an object's yaw and z must be finite numbers")
+            raise DataError("an object's yaw and z must be finite numbers")
         if self.z is not None and not (0.0 <= self.z <= 3.0):
-            raise ValueError(f"an object's z (its bottom's height) must be 0-3 m, got {self.z}")
+            raise DataError(f"an object's z (its bottom's height) must be 0-3 m, got {self.z}")
         if self.bottom > 0.0 and not self.fixed:
-            raise ValueError("only a fixed object can hang above the floor (z > 0 needs fixed = true)")
+            raise DataError("only a fixed object can hang above the floor (z > 0 needs fixed = true)")
 
     @property
     def spec(self) -> ObjectSpec:
@@ -158,13 +159,13 @@ class Ramp:
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", tuple(float(v) for v in self.position))
         if len(self.position) != 2:
-            raise ValueError("a ramp's position is [x, y] of its toe's centre")
+            raise DataError("a ramp's position is [x, y] of its toe's centre")
         if not _finite(*self.position, self.yaw, self.width, self.length, self.slope):
-            raise ValueError("a ramp's position, yaw, width, length and slope must be finite numbers")
+            raise DataError("a ramp's position, yaw, width, length and slope must be finite numbers")
         if not (0.05 <= self.width <= 10.0 and 0.05 <= self.length <= 10.0):
-            raise ValueError(f"a ramp's width and length must be 0.05-10 m, got {self.width} and {self.length}")
+            raise DataError(f"a ramp's width and length must be 0.05-10 m, got {self.width} and {self.length}")
         if not (0.5 <= self.slope <= 60.0):
-            raise ValueError(f"a ramp's slope must be 0.5-60 degrees, got {self.slope}")
+            raise DataError(f"a ramp's slope must be 0.5-60 degrees, got {self.slope}")
 
     @property
     def height(self) -> float:
@@ -209,13 +210,13 @@ class Gap:
 
     def __post_init__(self) -> None:
         if not _finite(self.distance, self.width, self.yaw):
-            raise ValueError("a gap's distance, width and yaw must be finite numbers")
+            raise DataError("a gap's distance, width and yaw must be finite numbers")
         if not (0.0 <= self.distance <= 5.0):
-            raise ValueError(f"a gap's distance must be 0-5 m, got {self.distance}")
+            raise DataError(f"a gap's distance must be 0-5 m, got {self.distance}")
         if not (0.01 <= self.width <= 2.0):
-            raise ValueError(f"a gap's width must be 0.01-2 m, got {self.width}")
+            raise DataError(f"a gap's width must be 0.01-2 m, got {self.width}")
         if not (-80.0 <= self.yaw <= 80.0):
-            raise ValueError(f"a gap's yaw must be -80..80 degrees, got {self.yaw}")
+            raise DataError(f"a gap's yaw must be -80..80 degrees, got {self.yaw}")
 
     @property
     def normal(self) -> np.ndarray:
@@ -244,7 +245,7 @@ class TraverseLayout:
         object.__setattr__(self, "ramps", tuple(self.ramps))
         object.__setattr__(self, "gaps", tuple(self.gaps))
         if len(self.gaps) > 1:
-            raise ValueError("a traverse world has at most one gap")
+            raise DataError("a traverse world has at most one gap")
 
     def to_dict(self) -> dict:
         return {"items": [i.to_dict() for i in self.items], "ramps": [r.to_dict() for r in self.ramps],
@@ -323,26 +324,26 @@ def check_layout(layout: TraverseLayout, robot: MobileRobotConfig = MobileRobotC
     me = _robot_footprint(robot)
     for i, it in enumerate(layout.items):
         if it.bottom < robot.height + margin and _rects_overlap(me, it.footprint(), margin):
-            raise ValueError(f"object {i} at {list(it.position)} overlaps the robot's start position; move it away")
+            raise DataError(f"object {i} at {list(it.position)} overlaps the robot's start position; move it away")
     for i, r in enumerate(layout.ramps):
         if _rects_overlap(me, r.footprint(), margin):
-            raise ValueError(f"ramp {i} at {list(r.position)} overlaps the robot's start position; move it away")
+            raise DataError(f"ramp {i} at {list(r.position)} overlaps the robot's start position; move it away")
     for i, a in enumerate(layout.items):
         for j in range(i + 1, len(layout.items)):
             b = layout.items[j]
             if a.fixed and b.fixed:
                 continue  # fixed bodies may interpenetrate: nothing moves them
             if a.bottom < b.top and b.bottom < a.top and _rects_overlap(a.footprint(), b.footprint()):
-                raise ValueError(f"objects {i} and {j} overlap; move one of them")
+                raise DataError(f"objects {i} and {j} overlap; move one of them")
         if not a.fixed:
             for k, r in enumerate(layout.ramps):
                 if _rects_overlap(a.footprint(), r.footprint()):
-                    raise ValueError(f"object {i} overlaps ramp {k}; a loose object must stand on the floor")
+                    raise DataError(f"object {i} overlaps ramp {k}; a loose object must stand on the floor")
     for i, g in enumerate(layout.gaps):
         p = g.near_point(robot.length / 2)
         side = (_corners(*me) - p) @ g.normal
         if side.max() > -margin:
-            raise ValueError(f"gap {i}'s near edge runs under the robot's start position; "
+            raise DataError(f"gap {i}'s near edge runs under the robot's start position; "
                              "give it a larger distance or a smaller yaw")
 
 
@@ -372,7 +373,7 @@ def sample_clutter(rng: np.random.Generator, max_objects: int = 12, size_range: 
     """0-``max_objects`` loose objects of random shape, size, place and yaw (thesis 5.6.1)."""
     lo, hi = size_range
     if not (0.01 <= lo <= hi <= 1.0):
-        raise ValueError(f"object sizes must satisfy 0.01 <= min <= max <= 1.0 m, got {lo} and {hi}")
+        raise DataError(f"object sizes must satisfy 0.01 <= min <= max <= 1.0 m, got {lo} and {hi}")
 
     def make(g: np.random.Generator) -> Item:
         shape = shapes[int(g.integers(len(shapes)))]
@@ -422,7 +423,7 @@ def sample_ramp(rng: np.random.Generator, x_range: tuple[float, float] = (0.3, 0
                     _round(rng.uniform(*slope_range)))
         if not _rects_overlap(me, ramp.footprint(), 0.05):
             return TraverseLayout(ramps=(ramp,))
-    raise ValueError("could not place a ramp clear of the robot; widen the ramps' position range")
+    raise DataError("could not place a ramp clear of the robot; widen the ramps' position range")
 
 
 def sample_gap(rng: np.random.Generator, distance_range: tuple[float, float] = (0.10, 1.00),
@@ -438,7 +439,7 @@ def sample_gap(rng: np.random.Generator, distance_range: tuple[float, float] = (
         except ValueError:
             continue
         return layout
-    raise ValueError("could not place a gap ahead of the robot; widen the gaps' distance range")
+    raise DataError("could not place a gap ahead of the robot; widen the gaps' distance range")
 
 
 # -- layout files -----------------------------------------------------------------------------

@@ -20,6 +20,7 @@ from features.objects import centres as object_centres
 from sim.camera import CameraConfig, MeshInstance, RangeCamera
 from sim.hand import Hand, HandConfig
 from sim.objects import ObjectSpec, build_object, object_mesh
+from features.errors import DataError
 
 __all__ = ["TableConfig", "TableWorld", "ObjectTruth"]
 
@@ -110,7 +111,7 @@ class TableWorld:
         self.steps = 0
         held = [i for i, s in enumerate(objects) if s.held]
         if len(held) > 1:
-            raise ValueError("the hand can hold only one object")
+            raise DataError("the hand can hold only one object")
         if held:
             self._start_held(held[0])
         self.known = np.empty((0, N_OBJECT_FEATURES))

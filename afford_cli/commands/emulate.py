@@ -9,6 +9,7 @@ import typer
 
 from afford_cli.commands.plan import render_plan
 from afford_cli.errors import AffordError
+from features.errors import DataError
 from afford_cli.learning import forward_model, load_model
 from afford_cli.options import Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
 from afford_cli.output import Output
@@ -44,7 +45,7 @@ def emulate(
     loaded.check_schema(sc.schema, "this scene's perception")
     try:
         goal = goal_from_observation(observed, state, loaded.schema)
-    except ValueError as exc:
+    except DataError as exc:
         raise AffordError(str(exc)) from None
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}
     ranked = rank_plans(fm, state, goal, alternatives, max_replans=max_replans, **limits)

@@ -11,6 +11,7 @@ from rich import box
 from rich.table import Table
 
 from afford_cli.errors import AffordError
+from features.errors import DataError
 from afford_cli.learning import forward_model, load_model
 from afford_cli.options import (
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
@@ -100,7 +101,7 @@ def plan(
                 sc, specs = scene_layout(scene, base + e, None, objects=objects, reachable=reachable)
                 try:
                     entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
-                except (AffordError, ValueError) as exc:  # e.g. an object hidden behind another
+                except (AffordError, DataError) as exc:  # e.g. an object hidden behind another
                     entries.append({"seed": base + e, "skipped": str(exc),
                                     "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})
                 update(e + 1)

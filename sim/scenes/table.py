@@ -41,6 +41,7 @@ from sim.layout import layout_toml, parse_layout
 from sim.objects import SHAPES, ObjectSpec
 from sim.registry import register_scene
 from sim.world import TableConfig, TableWorld
+from features.errors import DataError
 
 __all__ = ["TableScene", "TableSceneConfig"]
 
@@ -61,12 +62,12 @@ class TableSceneConfig:
     def __post_init__(self) -> None:
         lo, hi = self.size_range
         if not (0.02 <= lo <= hi <= 0.6):
-            raise ValueError(f"object sizes must satisfy 0.02 <= min <= max <= 0.6 m, got {lo} and {hi}")
+            raise DataError(f"object sizes must satisfy 0.02 <= min <= max <= 0.6 m, got {lo} and {hi}")
         if self.max_steps < 1:
-            raise ValueError(f"an episode needs at least one step, got max_steps {self.max_steps}")
+            raise DataError(f"an episode needs at least one step, got max_steps {self.max_steps}")
         for s in self.shapes:
             if s not in SHAPES:
-                raise ValueError(f"unknown shape {s!r}; known shapes: {', '.join(SHAPES)}")
+                raise DataError(f"unknown shape {s!r}; known shapes: {', '.join(SHAPES)}")
 
 
 @register_scene("table")
@@ -107,7 +108,7 @@ class TableScene:
         lo = c.size_range[0] if size_min is None else float(size_min)
         hi = c.size_range[1] if size_max is None else float(size_max)
         if lo > hi:
-            raise ValueError(f"the smallest object size ({lo}) is larger than the largest ({hi})")
+            raise DataError(f"the smallest object size ({lo}) is larger than the largest ({hi})")
         return type(self)(replace(c, size_range=(lo, hi), max_steps=c.max_steps if max_steps is None else int(max_steps)))
 
     def sample(self, rng: np.random.Generator, objects: int = 1, reachable: bool = False) -> list[ObjectSpec]:
@@ -162,7 +163,7 @@ class TableScene:
                     out.append(cand)
                     if len(out) == n:
                         return out
-        raise ValueError(f"could not place {n} objects apart on the table; try fewer or smaller objects")
+        raise DataError(f"could not place {n} objects apart on the table; try fewer or smaller objects")
 
     def check_layout(self, objects: list[ObjectSpec]) -> None:
         """Raise ValueError (one sentence) if a layout's objects do not stand on this table."""
@@ -170,7 +171,7 @@ class TableScene:
         for i, o in enumerate(objects):
             x, y = o.position
             if not (w.table_near <= x <= w.table_far and -w.table_width / 2 <= y <= w.table_width / 2):
-                raise ValueError(f"object {i} at ({x}, {y}) is not on the table "
+                raise DataError(f"object {i} at ({x}, {y}) is not on the table "
                                  f"(x {w.table_near}..{w.table_far}, y {-w.table_width / 2}..{w.table_width / 2})")
             th = math.radians(o.yaw)
             e = o.extents
@@ -178,12 +179,12 @@ class TableScene:
             hy = (abs(math.sin(th)) * e[0] + abs(math.cos(th)) * e[1]) / 2
             if (x - hx < w.table_near - 0.01 or x + hx > w.table_far + 0.01
                     or abs(y) + hy > w.table_width / 2 + 0.01) and not o.held:
-                raise ValueError(f"object {i} at ({x}, {y}) hangs over the table's edge; move it inwards")
+                raise DataError(f"object {i} at ({x}, {y}) hangs over the table's edge; move it inwards")
         for i, a in enumerate(objects):
             for j in range(i + 1, len(objects)):
                 b = objects[j]
                 if math.dist(a.position, b.position) < 0.5 * (min(a.extents[:2]) + min(b.extents[:2])):
-                    raise ValueError(f"objects {i} and {j} overlap")
+                    raise DataError(f"objects {i} and {j} overlap")
 
     def build(self, objects: list[ObjectSpec], rng: np.random.Generator) -> TableWorld:
         """A fresh world with these objects (one per episode: a reused scene carries history)."""
