@@ -329,7 +329,7 @@ class _Margins(ClassifierMixin, BaseEstimator):
     def fit(self, X=None, y=None):
         scale, ovr = self.pipeline.named_steps["scale"], self.pipeline.named_steps["svc"]
         self.mean_, self.std_ = scale.mean_, scale.scale_
-        self.parts_ = [(e.support_vectors_, (e.support_vectors_ ** 2).sum(1), e.dual_coef_[0], e.intercept_[0], e._gamma)
+        self.parts_ = [(e.support_vectors_, (e.support_vectors_ ** 2).sum(1), e.dual_coef_[0], e.intercept_[0], float(e.gamma))  # the grid passes gamma as a number
                        for e in ovr.estimators_]
         self.classes_ = ovr.classes_
         return self

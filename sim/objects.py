@@ -84,6 +84,14 @@ class ObjectSpec:
         return np.array([length, d, d], dtype=float)  # lying: axis along local x
 
     @property
+    def half_footprint(self) -> tuple[float, float]:
+        """Half extents (x, y) of the yawed object's axis-aligned footprint."""
+        e = self.extents
+        th = math.radians(self.yaw)
+        c, s = abs(math.cos(th)), abs(math.sin(th))
+        return (c * e[0] + s * e[1]) / 2, (s * e[0] + c * e[1]) / 2
+
+    @property
     def height(self) -> float:
         return float(self.extents[2])
 

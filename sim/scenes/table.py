@@ -133,12 +133,8 @@ class TableScene:
         n = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}[shape]
         size = tuple(float(round(v, 4)) for v in rng.uniform(lo, hi, size=n))
         yaw = float(rng.uniform(0.0, 360.0))
-        probe = ObjectSpec(shape, size, (0.0, 0.0), yaw)
-        e = probe.extents
         # Half extents of the yawed footprint, so the object starts wholly on the table.
-        th = math.radians(yaw)
-        hx = (abs(math.cos(th)) * e[0] + abs(math.sin(th)) * e[1]) / 2
-        hy = (abs(math.sin(th)) * e[0] + abs(math.cos(th)) * e[1]) / 2
+        hx, hy = ObjectSpec(shape, size, (0.0, 0.0), yaw).half_footprint
         w = c.world
         x = float(rng.uniform(w.table_near + hx, max(w.table_near + hx, w.table_far - hx)))
         y = float(rng.uniform(-w.table_width / 2 + hy, max(-w.table_width / 2 + hy, w.table_width / 2 - hy)))
@@ -173,10 +169,7 @@ class TableScene:
             if not (w.table_near <= x <= w.table_far and -w.table_width / 2 <= y <= w.table_width / 2):
                 raise DataError(f"object {i} at ({x}, {y}) is not on the table "
                                  f"(x {w.table_near}..{w.table_far}, y {-w.table_width / 2}..{w.table_width / 2})")
-            th = math.radians(o.yaw)
-            e = o.extents
-            hx = (abs(math.cos(th)) * e[0] + abs(math.sin(th)) * e[1]) / 2
-            hy = (abs(math.sin(th)) * e[0] + abs(math.cos(th)) * e[1]) / 2
+            hx, hy = o.half_footprint
             if (x - hx < w.table_near - 0.01 or x + hx > w.table_far + 0.01
                     or abs(y) + hy > w.table_width / 2 + 0.01) and not o.held:
                 raise DataError(f"object {i} at ({x}, {y}) hangs over the table's edge; move it inwards")
