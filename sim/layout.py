@@ -20,7 +20,7 @@ from pathlib import Path
 from features.errors import DataError
 from sim.objects import SHAPES, ObjectSpec
 
-__all__ = ["LayoutError", "parse_layout", "load_layout", "layout_toml"]
+__all__ = ["LayoutError", "parse_layout", "load_layout", "layout_toml", "read_layout_file"]
 
 _KEYS = {"shape", "size", "position", "yaw", "held"}
 
@@ -78,7 +78,8 @@ def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
     return specs
 
 
-def load_layout(path: str | Path) -> list[ObjectSpec]:
+def read_layout_file(path: str | Path) -> str:
+    """The text of a layout file; a missing, unreadable or non-text file is one LayoutError sentence."""
     if str(path) in ("", "-"):
         raise LayoutError("give a layout file name (layouts are not read from standard input)")
     p = Path(path)
@@ -87,12 +88,16 @@ def load_layout(path: str | Path) -> list[ObjectSpec]:
     if p.is_dir():
         raise LayoutError(f"layout file {path} is a directory")
     try:
-        text = p.read_text(encoding="utf-8")
+        return p.read_text(encoding="utf-8")
     except UnicodeDecodeError:
         raise LayoutError(f"layout file {path} is not UTF-8 text") from None
     except OSError as exc:
         raise LayoutError(f"cannot read layout file {path} ({exc.strerror})") from None
-    return parse_layout(text, str(path))
+
+
+def load_layout(path: str | Path) -> list[ObjectSpec]:
+    """A table layout file's objects."""
+    return parse_layout(read_layout_file(path), str(path))
 
 
 def layout_toml(specs: list[ObjectSpec]) -> str:

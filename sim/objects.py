@@ -17,13 +17,24 @@ import open3d as o3d
 import sapien
 from features.errors import DataError
 
-__all__ = ["SHAPES", "ObjectSpec", "build_object", "object_mesh", "yaw_quaternion"]
+__all__ = ["SHAPES", "ObjectSpec", "box_mesh", "build_object", "object_mesh", "yaw_quaternion"]
 
 #: The object shapes the scenes know, in the order ground truth stores them.
 SHAPES = ("box", "cylinder", "lying-cylinder", "sphere")
 
 # Rotation of a cylinder's local frame so that its axis (x) points up (z).
 _UPRIGHT = np.array([math.cos(-math.pi / 4), 0.0, math.sin(-math.pi / 4), 0.0])
+
+
+def box_mesh(half) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and triangles of a box of half extents ``half`` about its centre (for the range sensors)."""
+    h = np.asarray(half)
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float) * h
+    faces = np.array([
+        [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+        [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
+    ], dtype=np.uint32)
+    return corners, faces
 
 
 def yaw_quaternion(yaw_deg: float) -> np.ndarray:

@@ -34,7 +34,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from features.errors import DataError
-from sim.layout import LayoutError
+from sim.layout import read_layout_file
 
 __all__ = ["Scene", "SceneOptionError", "load_layout_file", "LOOPS", "LABEL_SOURCES"]
 
@@ -79,20 +79,7 @@ class Scene(Protocol):
 
 def load_layout_file(scene: Scene, path: str | Path):
     """Read and parse a layout file for ``scene``; every mistake is one LayoutError sentence."""
-    if str(path) in ("", "-"):
-        raise LayoutError("give a layout file name (layouts are not read from standard input)")
-    p = Path(path)
-    if not p.exists():
-        raise LayoutError(f"layout file {path} does not exist")
-    if p.is_dir():
-        raise LayoutError(f"layout file {path} is a directory")
-    try:
-        text = p.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise LayoutError(f"layout file {path} is not UTF-8 text") from None
-    except OSError as exc:
-        raise LayoutError(f"cannot read layout file {path} ({exc.strerror})") from None
-    return scene.parse_layout(text, str(path))
+    return scene.parse_layout(read_layout_file(path), str(path))
 
 
 def check_options(scene: Scene, given: dict[str, Any], kind: str = "option") -> None:

@@ -68,7 +68,7 @@ import sapien
 from features import RangeImage
 from sim.camera import MeshInstance
 from sim.layout import LayoutError
-from sim.objects import SHAPES, ObjectSpec, build_object, object_mesh, yaw_quaternion
+from sim.objects import SHAPES, ObjectSpec, box_mesh, build_object, object_mesh, yaw_quaternion
 from sim.robots.mobile import MobileRobot, MobileRobotConfig, Odometry
 from sim.scanner import RangeScanner, ScannerConfig
 from features.errors import DataError
@@ -305,14 +305,6 @@ def _rects_overlap(a, b, margin: float = 0.0) -> bool:
 
 def _robot_footprint(robot: MobileRobotConfig):
     return (0.0, 0.0), (robot.length / 2, robot.width / 2), 0.0
-
-
-def _box_mesh(half) -> tuple[np.ndarray, np.ndarray]:
-    h = np.asarray(half, dtype=float)
-    v = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float) * h
-    t = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]], dtype=np.uint32)
-    return v, t
 
 
 def check_layout(layout: TraverseLayout, robot: MobileRobotConfig = MobileRobotConfig(), margin: float = 0.02) -> None:
@@ -624,7 +616,7 @@ class TraverseWorld:
         b.add_box_collision(half_size=list(half), material=material)
         b.set_initial_pose(pose)
         b.build_static(name="slab")
-        v, t = _box_mesh(half)
+        v, t = box_mesh(half)
         self._static.append(MeshInstance(v, t, np.asarray(pose.p), np.asarray(pose.q)))
 
     def _build_floor(self, material) -> None:
@@ -667,7 +659,7 @@ class TraverseWorld:
             out.append(MeshInstance(v, t, np.asarray(body.pose.p), np.asarray(body.pose.q)))
         pose = self.robot.base.entity_pose
         for centre, half in self.config.robot.body_boxes()[:1]:  # the head holds the scanner: not in view
-            v, t = _box_mesh(half)
+            v, t = box_mesh(half)
             out.append(MeshInstance(v + np.asarray(centre), t, np.asarray(pose.p), np.asarray(pose.q), own_body=True))
         return out
 

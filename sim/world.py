@@ -19,7 +19,7 @@ from features.objects import N_OBJECT_FEATURES
 from features.objects import centres as object_centres
 from sim.camera import CameraConfig, MeshInstance, RangeCamera
 from sim.hand import Hand, HandConfig
-from sim.objects import ObjectSpec, build_object, object_mesh
+from sim.objects import ObjectSpec, box_mesh, build_object, object_mesh
 from features.errors import DataError
 
 __all__ = ["TableConfig", "TableWorld", "ObjectTruth"]
@@ -64,16 +64,6 @@ class ObjectTruth:
     in_hand: bool
 
 
-def _box_mesh(half: tuple[float, float, float]) -> tuple[np.ndarray, np.ndarray]:
-    h = np.asarray(half)
-    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float) * h
-    faces = np.array([
-        [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-        [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
-    ], dtype=np.uint32)
-    return corners, faces
-
-
 class TableWorld:
     """A fresh world holding ``objects`` on the table (and the hand at home)."""
 
@@ -91,9 +81,9 @@ class TableWorld:
         table_pose = sapien.Pose([c.table_near + c.table_depth / 2, 0.0, c.table_top / 2])
         tb.set_initial_pose(table_pose)
         self.table = tb.build_static(name="table")
-        self._table_mesh = (*_box_mesh(half_table), np.asarray(table_pose.p), np.array([1.0, 0, 0, 0]))
+        self._table_mesh = (*box_mesh(half_table), np.asarray(table_pose.p), np.array([1.0, 0, 0, 0]))
         self.hand = Hand(self.scene, c.hand)
-        self._hand_meshes = {link.name: _box_mesh(c.hand.palm_half if link.name == "palm" else c.hand.finger_half)
+        self._hand_meshes = {link.name: box_mesh(c.hand.palm_half if link.name == "palm" else c.hand.finger_half)
                              for link in self.hand.body_links}
         self.specs = list(objects)
         self.bodies = [build_object(self.scene, s, c.table_top, c.density, material) for s in objects]

@@ -27,10 +27,10 @@ def test_ranges_are_distances_along_the_ray_not_depth():
 
 
 def test_casting_only_near_moving_bodies_gives_the_full_image():
-    from sim.world import _box_mesh
+    from sim.objects import box_mesh
 
     config = replace(CameraConfig(), noise=0.0)
-    v, t = _box_mesh((0.35, 0.5, 0.375))
+    v, t = box_mesh((0.35, 0.5, 0.375))
     table = MeshInstance(v, t, np.array([0.75, 0.0, 0.375]), np.array([1.0, 0, 0, 0]))
     moving = [_sphere((0.6, -0.2, 0.85)), _sphere((0.9, 0.3, 0.95), 0.3)]
     fast = RangeCamera(config)

@@ -14,9 +14,9 @@ ROI = RegionOfInterest(x=(0.4, 1.1), y=(-0.5, 0.5), z=(0.758, 1.55))
 
 
 def _table_mesh():
-    from sim.world import _box_mesh
+    from sim.objects import box_mesh
 
-    v, t = _box_mesh((0.35, 0.5, 0.375))
+    v, t = box_mesh((0.35, 0.5, 0.375))
     return MeshInstance(v, t, np.array([0.75, 0.0, 0.375]), np.array([1.0, 0, 0, 0]))
 
 

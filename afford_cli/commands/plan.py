@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 from enum import Enum
-from typing import Annotated, Optional
+from typing import Annotated
 
-import numpy as np
 import typer
 from rich import box
 from rich.table import Table
