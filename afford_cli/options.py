@@ -41,8 +41,8 @@ MaxReplans = Annotated[int, typer.Option("--max-replans", min=0, max=20, help="M
 
 def check_scene_source(layout: Optional[str], seed: Optional[int], **drawn) -> None:
     """``--layout`` pins the scene; ``--seed`` (with the drawing options, given when set) draws one; not both."""
-    if layout is not None and (seed is not None or any(v is not None for v in drawn.values())):
-        extra = ", ".join(["--seed"] + [f"--{k.replace('_', '-')}" for k in drawn])
-        raise typer.BadParameter(f"--layout pins the scene; it does not go with {extra}")
+    given = (["--seed"] if seed is not None else []) + [f"--{k.replace('_', '-')}" for k, v in drawn.items() if v is not None]
+    if layout is not None and given:
+        raise typer.BadParameter(f"--layout pins the scene; it does not go with {' or '.join(given)}")
     if layout is None and seed is None:
         raise typer.BadParameter("give --layout FILE, or --seed S to draw a random scene")

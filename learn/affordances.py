@@ -104,13 +104,18 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
         _check_rows(data, b, rows, "feature selection")
         y = labels[rows]
         if np.unique(y).size < 2:
-            raise DataError(f"behaviour {name!r} has one effect category only; there is nothing to tell apart")
+            raise DataError(f"behaviour {name!r} has {_one_label(data)}; there is nothing to tell apart")
         fr = FeatureRelevance(method=method, top=top, feature_groups=groups, random_state=behaviour_seed(seed, b),
                               estimator=prefix_estimator(kernel) if method == "relieff" else None)
         out[name] = fr.fit(data.before_rows(rows), y)
         if progress is not None:
             progress(b + 1)
     return out
+
+
+def _one_label(data: Interactions) -> str:
+    return ("one effect category only" if data.label_source == "discovered"
+            else "one result only (every interaction of it ended the same way)")
 
 
 def prefix_estimator(kernel: str):
@@ -173,7 +178,7 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
         _check_rows(data, b, rows, "training")
         y = labels[rows]
         if np.unique(y).size < 2:
-            raise DataError(f"behaviour {name!r} has one effect category only; there is nothing to predict")
+            raise DataError(f"behaviour {name!r} has {_one_label(data)}; there is nothing to predict")
         X = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b))
         out[name] = AffordancePredictor(kernel=kernel, cv=folds, n_jobs=n_jobs,
                                         random_state=behaviour_seed(seed, b)).fit(X, y)

@@ -87,6 +87,4 @@ def check_options(scene: Scene, given: dict[str, Any], kind: str = "option") -> 
     for name, value in given.items():
         if value is not None and name not in scene.options and name not in scene.sample_options:
             flag = "--" + name.replace("_", "-")
-            raise SceneOptionError(f"{flag} does not apply to scene {scene.name!r}"
-                                   + (f" (its options: {', '.join('--' + o.replace('_', '-') for o in scene.options)})"
-                                      if scene.options else ""))
+            raise SceneOptionError(f"{flag} does not apply to scene {scene.name!r}")

@@ -234,3 +234,9 @@ def test_predict_answers_inverse_queries(pipeline):
     probs = [r["probability"] for r in out["ranking"]]
     assert len(probs) == 8 and probs == sorted(probs, reverse=True)
     assert all(0 <= p <= 1 for p in probs)
+
+
+def test_a_scene_the_model_cannot_perceive_is_refused_once_not_skipped(pipeline):
+    result = runner.invoke(app, ["plan", str(pipeline / "model.afford"), "--scene", "traverse-gaps", "--seed", "1",
+                                 "--episodes", "2", "--goal", "*:visibility=0"])
+    assert result.exit_code == 1 and "another feature schema" in result.output

@@ -128,3 +128,11 @@ def test_the_example_layouts_do_what_their_comments_say(name):
     after = world.act("go-forward", 0)
     assert np.array_equal(before, after)  # nothing is perceived after a move: the start stays the entity
     assert scene.results[world.last_result] == EXAMPLES[name]
+
+
+def test_the_grid_is_a_setting_chapter_6_uses_30_by_30_in_one_layer(tmp_path):
+    out = json.loads(ok(["explore", "--scene", "traverse-gaps", "--episodes", "1", "--grid", "30", "--layers", "1",
+                         "-o", str(tmp_path / "g.afford"), "--json"]).stdout)
+    assert out["n_features"] == 30 * 30 * 39 and out["channels"] == {"range": 2700, "shape": 32400}
+    assert "--grid does not apply to scene 'table'" in fails(["explore", "--scene", "table", "--grid", "5",
+                                                              "-o", str(tmp_path / "x")], code=2)

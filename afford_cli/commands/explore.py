@@ -69,6 +69,8 @@ def explore(
     max_steps: Annotated[Optional[int], typer.Option("--max-steps", min=1, help="Most behaviours per episode (scenes that play, Algorithm 5; 10 by default).")] = None,
     size_min: Annotated[Optional[float], typer.Option("--size-min", help="Smallest object dimension, metres (scenes with random objects).")] = None,
     size_max: Annotated[Optional[float], typer.Option("--size-max", help="Largest object dimension, metres (scenes with random objects).")] = None,
+    grid: Annotated[Optional[int], typer.Option("--grid", min=1, max=60, help="Grid cells per side of the range image (scenes that perceive grid features: 5 in chapter 5, 30 in chapter 6).")] = None,
+    layers: Annotated[Optional[int], typer.Option("--layers", min=1, max=8, help="Overlapping grid layers (4 in chapter 5, 1 in chapter 6).")] = None,
     json: Json = False,
 ) -> None:
     """Let the robot explore: random worlds, its behaviours, what happened recorded (Algorithm 5 or 1)."""
@@ -83,7 +85,7 @@ def explore(
         raise typer.BadParameter(f"--size-min ({size_min}) is larger than --size-max ({size_max})")
     check_output(output)
     out = Output(json, stdout_busy=output == "-")
-    sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps)
+    sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps, grid=grid, layers=layers)
     data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
                           workers=workers)
 

@@ -17,7 +17,7 @@ from afford_cli.options import (
 )
 from afford_cli.output import Output
 from afford_cli.planning import parse_goals, plan_once
-from afford_cli.scenes_io import scene_layout
+from afford_cli.scenes_io import make_scene, scene_layout
 from plan.report import summarise
 
 
@@ -91,6 +91,8 @@ def plan(
     out = Output(json)
     base = seed or 0
     entries = []
+    # a scene the model cannot perceive is refused once, not skipped episode by episode
+    loaded.check_schema(make_scene(scene).schema, "this scene's perception")
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable)
         entries.append(plan_once(loaded, fm, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives))
