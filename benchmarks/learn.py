@@ -95,17 +95,21 @@ def given_labels(args) -> None:
                                 workers=2)
     before = peak_mb()
     labels = data.result.astype(int)
-    relevance, relieff_s = timed(rank_features, data, labels, method="relieff", seed=0)
+    learner = data.scene.get("learner") or {}  # the scene's, as select-features and train take it
+    kernel, folds = str(learner.get("kernel", "rbf")), int(learner.get("folds", 3))
+    relevance, relieff_s = timed(rank_features, data, labels, method="relieff", seed=0, kernel=kernel)
     chosen = {k: v.selected_ for k, v in relevance.items()}
     after_relieff = peak_mb()
-    _, train_s = timed(train_predictors, data, labels, chosen, seed=0)
+    _, train_s = timed(train_predictors, data, labels, chosen, kernel=kernel, folds=folds, seed=0)
     result = {
         "benchmark": "learn",
         "scene": args.scene,
         "interactions": len(data),
         "features": len(data.schema),
         "selected": {k: int(len(v)) for k, v in chosen.items()},
-        "seconds": {"explore_2_workers": explore_s, "select_relieff": relieff_s, "train_rbf": train_s,
+        "kernel": kernel,
+        "folds": folds,
+        "seconds": {"explore_2_workers": explore_s, "select_relieff": relieff_s, "train": train_s,
                     "pipeline_relieff_train": round(relieff_s + train_s, 2)},
         "peak_memory_mb": {"after_loading": before, "after_relieff": after_relieff, "after_train": peak_mb()},
     }
