@@ -1,4 +1,4 @@
-"""``afford demo``: the main job on the built-in table scene, stage by stage.
+"""``afford demo``: the main job on the built-in table scene, stage by stage, then the mobile robot.
 
 Each stage is the same command a user would type (the demo calls the command functions),
 so what it prints is what those commands print.
@@ -17,11 +17,12 @@ from afford_cli.output import Output
 
 def demo(
     out_dir: Annotated[Path, typer.Option("--out", help="Directory for the demo's artefacts.")] = Path("demo-out"),
-    interactions: Annotated[int, typer.Option("--interactions", min=200, help="Interactions to learn from.")] = 2000,
+    interactions: Annotated[int, typer.Option("--interactions", min=200, help="Interactions to learn from (at the table).")] = 2000,
+    mobile: Annotated[int, typer.Option("--mobile", min=0, help="Environments the mobile robot explores after the table (0: none).")] = 60,
     seed: Seed = 0,
     workers: Workers = 2,
 ) -> None:
-    """Explore the table scene, learn its affordances, and measure them on new interactions."""
+    """Explore the table scene, learn its affordances, measure them, plan and emulate; then the mobile robot."""
     from afford_cli.scenes_io import make_scene
     from afford_cli.commands import cluster, emulate, evaluate, explore, inspect, plan, predict, select_features, train
 
@@ -56,4 +57,17 @@ def demo(
         Output().warn(f"example layouts not found in {layouts}; skipping emulation")
     console.rule("[bold]9. inspect: the model file, verified")
     inspect.inspect(path["model"])
+    if mobile:
+        mob = {k: str(out_dir / f"traverse-{k}.afford") for k in ("interactions", "heldout", "features", "model")}
+        console.rule(f"[bold]10. the mobile robot (chapter 5): {mobile} random environments, every move tried, "
+                     "each judged by its own odometry")
+        explore.explore(output=mob["interactions"], scene="traverse", episodes=mobile, seed=seed, workers=workers)
+        console.rule("[bold]11. select-features and train on the given results (no cluster step)")
+        select_features.select_features(mob["interactions"], mob["features"], seed=seed)
+        train.train(mob["features"], mob["model"], seed=seed)
+        console.rule("[bold]12. evaluate on environments it has not seen; predict one and check every move")
+        explore.explore(output=mob["heldout"], scene="traverse", episodes=max(10, mobile // 3), seed=seed + 1,
+                        workers=workers)
+        evaluate.evaluate(mob["model"], mob["heldout"], baselines=True, seed=seed)
+        predict.predict(mob["model"], scene="traverse", seed=seed + 2, run_check=True)
     Output().info(f"artefacts in {out_dir}/")
