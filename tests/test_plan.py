@@ -416,3 +416,23 @@ def test_when_the_goal_needs_an_object_out_of_reach_the_robot_says_so():
     run = execute(world, fm, goal("0:visibility=0"), max_replans=3)
     assert not run.reached and run.replans == 1 and len(world.calls) == 1
     assert run.reason.startswith("no plan found") and "cannot reach object 0 where it lies" in run.reason
+
+
+def test_a_behaviour_without_a_target_moves_every_seen_object_by_its_own_outcome():
+    from plan.forward import SCENE
+
+    # a mobile robot drives: everything it sees shifts towards it, each object by its own effect
+    drive = replace(behaviour("drive", [(0.8, effect(-0.3)), (0.2, effect())]), target=None)
+    fm = ForwardModel([drive], SCHEMA, min_probability=0.0)
+    start = scene(1.0, 2.0)
+    outs = fm.outcomes(start, SCENE, 0)
+    assert len(outs) == 4 and abs(sum(o.probability for o in outs) - 1.0) < 1e-9
+    both = outs[0]
+    assert both.category == (0, 0) and abs(both.probability - 0.64) < 1e-9
+    assert np.allclose(both.state[:, X_MIN], [0.7, 1.7])
+    # the planner chains such steps on the whole scene, and never on one object alone
+    plan = best_first(fm, start, goal("0:x_min=0.4~0.02", "1:x_min=1.4~0.02"), max_depth=3)
+    assert plan.found and [s.obj for s in plan.steps] == [SCENE, SCENE]
+    assert abs(plan.path_probability - 0.64 ** 2) < 1e-9
+    assert abs(success_probability(fm, start, goal("0:x_min=0.4~0.02", "1:x_min=1.4~0.02"), plan.steps)
+               - 0.64 ** 2) < 1e-9
