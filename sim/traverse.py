@@ -314,6 +314,15 @@ def check_layout(layout: TraverseLayout, robot: MobileRobotConfig = MobileRobotC
     not overlap another object or a ramp, and a gap's near edge must lie ahead of the robot.
     """
     me = _robot_footprint(robot)
+    for kind, entries in (("object", layout.items), ("ramp", layout.ramps)):
+        for i, e in enumerate(entries):
+            if max(abs(e.position[0]), abs(e.position[1])) > _REACH:
+                raise DataError(f"{kind} {i} at {list(e.position)} lies off the floor, which reaches {_REACH:g} m "
+                                "about the robot; move it nearer")
+    for i, r in enumerate(layout.ramps):
+        for j in range(i + 1, len(layout.ramps)):
+            if _rects_overlap(r.footprint(), layout.ramps[j].footprint()):
+                raise DataError(f"ramps {i} and {j} overlap; move one of them")
     for i, it in enumerate(layout.items):
         if it.bottom < robot.height + margin and _rects_overlap(me, it.footprint(), margin):
             raise DataError(f"object {i} at {list(it.position)} overlaps the robot's start position; move it away")
@@ -567,6 +576,8 @@ def _scanner(config: ScannerConfig, origin: tuple[float, float, float]) -> Range
 
 
 _FLOOR_HALF = 10.0  # the floor and the slabs reach this far: well beyond the scanner's range
+#: Objects and ramps must stand within this distance (each axis) of the robot's start.
+_REACH = _FLOOR_HALF - 1.0
 
 
 class TraverseWorld:

@@ -170,3 +170,10 @@ def test_sampled_layouts_are_valid_starts(sampler):
     rng = np.random.default_rng(5)
     for _ in range(20):
         check_layout(sampler(rng))
+
+
+def test_layouts_off_the_floor_or_with_overlapping_ramps_are_refused():
+    with pytest.raises(ValueError, match="lies off the floor"):
+        check_layout(TraverseLayout(items=(Item("box", (0.3, 0.3, 0.3), (1000.0, 0.0)),)))
+    with pytest.raises(ValueError, match="ramps 0 and 1 overlap"):
+        check_layout(TraverseLayout(ramps=(Ramp((0.6, 0.0), 0.0, 1.0, 1.0, 10.0), Ramp((0.7, 0.1), 0.0, 1.0, 1.0, 5.0))))
