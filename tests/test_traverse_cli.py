@@ -68,6 +68,9 @@ def test_learning_with_given_results_needs_no_cluster_step(learned):
     info = json.loads(ok(["inspect", str(learned / "model.afford"), "--json"]).stdout)
     assert info["label_source"] == "given"
     assert set(info["n_selected"]) == set(info["behavior_names"]) and max(info["n_selected"].values()) <= 3900
+    for p in info["predictors"].values():  # the thesis's 5-fold cross-validation, per behaviour
+        assert p["cv"]["n_splits"] == 5 and 0.5 <= p["cv"]["cv_accuracy"] <= 1.0
+        assert set(p["results"]) == {"fail", "success"} and sum(p["results"].values()) == 36
     out = json.loads(ok(["evaluate", str(learned / "model.afford"), str(learned / "test.afford"), "--baselines",
                          "--json"]).stdout)
     for name, m in out["behaviors"].items():

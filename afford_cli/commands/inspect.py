@@ -48,6 +48,9 @@ def describe(art: Artifact) -> dict:
         info["result_rates"] = m["result_rates"]
     if m.get("relevance"):
         info["n_selected"] = {name: len(r.get("selected", [])) for name, r in m["relevance"].items()}
+    if art.kind == "model" and m.get("label_source") == "given":
+        info["predictors"] = {name: {"results": {c["name"]: c["count"] for c in m.get("categories", {}).get(name, [])},
+                                     "cv": m.get("cv", {}).get(name, {})} for name in info["behavior_names"]}
     if "effects" in m:
         info["behaviors"] = _behaviour_reports(m)
     if art.kind == "model":
@@ -91,6 +94,16 @@ def render(console, info: dict) -> None:
         console.print(ft)
     if info.get("result_rates"):
         render_result_rates(console, info["result_rates"])
+    if info.get("predictors"):
+        pt = Table(title="predictors of the given results")
+        for col in ("behaviour", "training rows by result", "features", "C", "cross-validated accuracy"):
+            pt.add_column(col)
+        for name, p in info["predictors"].items():
+            cv = p["cv"]
+            pt.add_row(name, ", ".join(f"{k} {v}" for k, v in p["results"].items()), str(info.get("n_selected", {}).get(name, "?")),
+                       str(cv.get("best_params", {}).get("C", "?")),
+                       f"{100 * cv['cv_accuracy']:.1f} % ({cv.get('n_splits', '?')} folds)" if "cv_accuracy" in cv else "?")
+        console.print(pt)
     if info.get("n_selected"):
         n = len(info["features"])
         console.print("relevant features kept: " + ", ".join(
