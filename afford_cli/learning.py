@@ -115,17 +115,19 @@ def read_selection(art: Artifact, data: Interactions) -> dict[str, np.ndarray]:
 _MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created", "command", "seed", "parents", "members"}
 
 
-def learner_settings(art: Artifact, data: Interactions, kernel: str | None = None, folds: int | None = None) -> tuple[str, int]:
+def learner_settings(art: Artifact | None, data: Interactions, kernel: str | None = None,
+                     folds: int | None = None) -> tuple[str, int]:
     """The kernel and folds to learn with: those given, else the scene's (``learner`` in its
     configuration), else the RBF kernel and 3 folds."""
     learner = data.scene.get("learner") if isinstance(data.scene.get("learner"), dict) else {}
     kernel = kernel if kernel is not None else str(learner.get("kernel", "rbf"))
     if kernel not in ("rbf", "linear"):
-        raise AffordError(f"{art.source} asks for an unknown kernel {kernel!r}; give --kernel")
+        raise AffordError(f"{art.source if art else 'the data'} asks for an unknown kernel {kernel!r}; give --kernel")
     try:
         folds = folds if folds is not None else int(learner.get("folds", 3))
     except (TypeError, ValueError):
-        raise AffordError(f"{art.source} asks for a number of folds that is not a number; give --folds") from None
+        raise AffordError(f"{art.source if art else 'the data'} asks for a number of folds that is not a number; "
+                          "give --folds") from None
     return kernel, folds
 
 

@@ -7,7 +7,7 @@ import numpy as np
 from afford_cli.errors import AffordError
 from features.errors import DataError
 
-__all__ = ["make_scene", "scene_layout", "open_world", "layout_json"]
+__all__ = ["make_scene", "scene_layout", "open_world"]
 
 
 def make_scene(name: str, **options):
@@ -64,11 +64,6 @@ def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_em
     except DataError as exc:
         raise AffordError(f"{layout or 'the scene'}: {exc}") from None
     return scene, specs
-
-
-def layout_json(scene, layout):
-    """A layout as plain data, for JSON reports."""
-    return scene.layout_json(layout)
 
 
 def open_world(scene, specs, seed: int):

@@ -23,6 +23,7 @@ from benchmarks._common import emit  # noqa: E402
 
 from afford_cli.artifacts import read_artifact  # noqa: E402
 from afford_cli.datasets import interactions_from_artifact  # noqa: E402
+from afford_cli.learning import learner_settings  # noqa: E402
 from learn.affordances import discover_effects, rank_features, train_predictors  # noqa: E402
 
 
@@ -95,8 +96,7 @@ def given_labels(args) -> None:
                                 workers=2)
     before = peak_mb()
     labels = data.result.astype(int)
-    learner = data.scene.get("learner") or {}  # the scene's, as select-features and train take it
-    kernel, folds = str(learner.get("kernel", "rbf")), int(learner.get("folds", 3))
+    kernel, folds = learner_settings(None, data)  # the scene's, as select-features and train take it
     relevance, relieff_s = timed(rank_features, data, labels, method="relieff", seed=0, kernel=kernel)
     chosen = {k: v.selected_ for k, v in relevance.items()}
     after_relieff = peak_mb()

@@ -1,6 +1,6 @@
 """Perception: range images to object feature vectors (imports nothing else of afford)."""
 
-from features.interactions import OUTCOMES, Interactions, encode_parameters, n_encoded
+from features.interactions import OUTCOMES, Interactions, encode_parameters
 from features.detect import Detection, RangeImage, RegionOfInterest, detect_objects
 from features.objects import N_OBJECT_FEATURES, object_features, perceive, track
 from features.schema import FeatureSchema, object_schema
@@ -10,7 +10,6 @@ __all__ = [
     "FeatureSchema",
     "Interactions",
     "encode_parameters",
-    "n_encoded",
     "OUTCOMES",
     "N_OBJECT_FEATURES",
     "RangeImage",

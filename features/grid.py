@@ -62,8 +62,8 @@ from functools import lru_cache
 import numpy as np
 
 from features.detect import RangeImage
-from features.schema import Channel, N_ANGLE_BINS, FeatureSchema
 from features.errors import DataError
+from features.schema import Channel, N_ANGLE_BINS, FeatureSchema
 
 __all__ = [
     "GridSpec",

@@ -13,19 +13,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from features.schema import FeatureSchema
 from features.errors import DataError
+from features.schema import FeatureSchema
 
-__all__ = ["Interactions", "OUTCOMES", "encode_parameters", "n_encoded"]
+__all__ = ["Interactions", "OUTCOMES", "encode_parameters"]
 
 #: Ground-truth outcome labels, the first that applies (issue: fell, left-view, lifted,
 #: dragged, no-change).
 OUTCOMES = ("fell", "left-view", "lifted", "dragged", "no-change")
-
-
-def n_encoded(parameters: list[dict]) -> int:
-    """Columns :func:`encode_parameters` gives for a behaviour's parameter list."""
-    return sum(2 if p.get("periodic") else 1 for p in parameters)
 
 
 def encode_parameters(values: np.ndarray, parameters: list[dict]) -> np.ndarray:

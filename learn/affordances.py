@@ -19,11 +19,11 @@ from typing import Callable
 import numpy as np
 
 from features import Interactions
+from features.errors import DataError
 from features.interactions import encode_parameters
 from learn.effects import EffectCategories
 from learn.predictors import AffordancePredictor
 from learn.relevance import FeatureRelevance, feature_groups
-from features.errors import DataError
 
 __all__ = [
     "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",

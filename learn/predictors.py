@@ -40,8 +40,8 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from learn.validation import check_finite
 from features.errors import DataError
+from learn.validation import check_finite
 
 __all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
 

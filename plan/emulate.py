@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from features import FeatureSchema
-from plan.goals import Constraint, Goal
 from features.errors import DataError
+from plan.goals import Constraint, Goal
 
 __all__ = ["goal_from_observation"]
 

@@ -32,8 +32,8 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from features.objects import extents
 from features.errors import DataError
+from features.objects import extents
 
 if TYPE_CHECKING:
     from sim.world import TableWorld

@@ -25,10 +25,10 @@ from typing import Callable, Iterator
 import numpy as np
 
 from features import Interactions
+from features.errors import DataError
 from features.interactions import OUTCOMES
 from sim.objects import SHAPES
 from sim.world import ObjectTruth, TableWorld
-from features.errors import DataError
 
 __all__ = ["explore", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
            "MOVED", "LIFTED"]
@@ -88,8 +88,6 @@ def interact(world: TableWorld, behavior, target: int, alpha: np.ndarray | None 
 
 @dataclass
 class _Rows:
-    before: list
-    after: list
     behavior: list
     params: list
     step: list
@@ -113,7 +111,7 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
     moving = schema.geometry
     behaviors = scene.behaviors
     n_params = max((len(b.parameters) for b in behaviors), default=0)
-    rows = _Rows([], [], [], [], [], {k: [] for k in (
+    rows = _Rows([], [], [], {k: [] for k in (
         "shape", "size", "pose_before", "pose_after", "in_hand_before", "in_hand_after",
         "reachable", "contact", "outcome")})
     f = world.perceive()

@@ -28,8 +28,8 @@ import numpy as np
 import open3d as o3d
 
 from features import RangeImage
-from sim.camera import MeshInstance
 from features.errors import DataError
+from sim.camera import MeshInstance
 
 __all__ = ["ScannerConfig", "RangeScanner", "scan_directions"]
 

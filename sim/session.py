@@ -14,8 +14,8 @@ import numpy as np
 
 from dataclasses import dataclass
 
-from sim.explore import Step, interact
 from features.errors import DataError
+from sim.explore import Step, interact
 
 __all__ = ["SimWorld", "Trial"]
 

@@ -66,12 +66,12 @@ import numpy as np
 import sapien
 
 from features import RangeImage
+from features.errors import DataError
 from sim.camera import MeshInstance
 from sim.layout import LayoutError
 from sim.objects import SHAPES, ObjectSpec, box_mesh, build_object, object_mesh, yaw_quaternion
 from sim.robots.mobile import MobileRobot, MobileRobotConfig, Odometry
 from sim.scanner import RangeScanner, ScannerConfig
-from features.errors import DataError
 
 __all__ = [
     "Item", "Ramp", "Gap", "TraverseLayout", "TraverseConfig", "TraverseWorld", "ROTATIONS",

@@ -15,12 +15,12 @@ import numpy as np
 import sapien
 
 from features import RegionOfInterest, perceive, track
+from features.errors import DataError
 from features.objects import N_OBJECT_FEATURES
 from features.objects import centres as object_centres
 from sim.camera import CameraConfig, MeshInstance, RangeCamera
 from sim.hand import Hand, HandConfig
 from sim.objects import ObjectSpec, box_mesh, build_object, object_mesh
-from features.errors import DataError
 
 __all__ = ["TableConfig", "TableWorld", "ObjectTruth"]
 

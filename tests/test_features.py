@@ -108,3 +108,16 @@ def test_track_prefers_a_visible_object_over_a_vanished_one():
     out = track(np.stack([gone, held]), dropped[None, :])
     assert out[0, 0] == 0 and out[1, 0] == 1
     assert np.allclose(out[1], dropped)
+
+
+def test_periodic_parameters_are_seen_as_sine_and_cosine():
+    import numpy as np
+
+    from features import encode_parameters
+
+    spec = [{"name": "approach", "periodic": True}, {"name": "speed"}]
+    near = encode_parameters(np.array([[359.0, 0.5], [1.0, 0.5]]), spec)
+    assert near.shape == (2, 3)  # an angle becomes two columns, a plain parameter stays one
+    assert np.abs(near[0] - near[1]).max() < 0.04  # 359 and 1 degrees are one direction
+    assert np.allclose(encode_parameters(np.array([90.0, 2.0]), spec), [1.0, 0.0, 2.0], atol=1e-12)
+    assert encode_parameters(np.zeros((4, 0)), []).shape == (4, 0)

@@ -139,3 +139,14 @@ def test_the_grid_is_a_setting_chapter_6_uses_30_by_30_in_one_layer(tmp_path):
     assert out["n_features"] == 30 * 30 * 39 and out["channels"] == {"range": 2700, "shape": 32400}
     assert "--grid does not apply to scene 'table'" in fails(["explore", "--scene", "table", "--grid", "5",
                                                               "-o", str(tmp_path / "x")], code=2)
+
+
+def test_kernel_and_folds_override_the_scenes_learner(learned, tmp_path):
+    default = json.loads(ok(["inspect", str(learned / "model.afford"), "--json"]).stdout)["training"]
+    assert (default["kernel"], default["folds"]) == ("linear", 5)  # the thesis's chapter 5 learner
+    ok(["select-features", str(learned / "train.afford"), "--kernel", "rbf", "-o", str(tmp_path / "f.afford")])
+    ok(["train", str(tmp_path / "f.afford"), "--kernel", "rbf", "--folds", "3", "-o", str(tmp_path / "m.afford")])
+    info = json.loads(ok(["inspect", str(tmp_path / "m.afford"), "--json"]).stdout)
+    assert (info["training"]["kernel"], info["training"]["folds"]) == ("rbf", 3)
+    assert all(p["cv"]["n_splits"] == 3 and "gamma" in p["cv"]["best_params"] for p in info["predictors"].values())
+    assert "--folds" in fails(["train", str(tmp_path / "f.afford"), "--folds", "1", "-o", str(tmp_path / "x")], code=2)

@@ -19,7 +19,7 @@ from rich.table import Table
 from afford_cli.learning import forward_model, load_model
 from afford_cli.options import Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
 from afford_cli.output import Output
-from afford_cli.scenes_io import layout_json, open_world, scene_layout
+from afford_cli.scenes_io import open_world, scene_layout
 
 #: Geometry features shown per entity, at most (an environment of 3900 features shows none).
 _SHOWN = 12
@@ -105,7 +105,7 @@ def predict(
     preds = predictions(loaded, fm, state)
     if run_check:
         check(loaded, sc, specs, seed or 0, preds)
-    result = {"objects": preds, "layout": layout_json(sc, specs), "label_source": loaded.label_source}
+    result = {"objects": preds, "layout": sc.layout_json(specs), "label_source": loaded.label_source}
     if want:
         from afford_cli.planning import parse_goals
         from plan.search import inverse_query

@@ -35,13 +35,13 @@ import numpy as np
 from dataclasses import replace
 
 from features import object_schema
+from features.errors import DataError
 from sim.behaviors import TABLE_BEHAVIORS
 from sim.camera import RangeCamera
 from sim.layout import layout_toml, parse_layout
 from sim.objects import SHAPES, ObjectSpec
 from sim.registry import register_scene
 from sim.world import TableConfig, TableWorld
-from features.errors import DataError
 
 __all__ = ["TableScene", "TableSceneConfig"]
 
