@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.afford-installed
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: setup demo test bench imports clean
+.PHONY: setup demo test bench reproduce imports clean
 
 setup: $(STAMP)
 
@@ -38,5 +38,13 @@ bench: $(STAMP)
 	$(PY) benchmarks/plan.py
 	$(PY) benchmarks/emulate.py
 
+# every thesis figure's script in its quick mode, then reproduce/index.md linking them
+reproduce: $(STAMP)
+	@mkdir -p reproduce
+	@for script in examples/reproduce/*.py; do echo "== $$script"; $(PY) $$script --quick --out reproduce || exit 1; done
+	@{ echo "# Thesis figures reproduced (quick mode)"; echo; \
+	  for f in reproduce/*.md; do [ "$$f" = reproduce/index.md ] || echo "- [$$(head -n 1 $$f | sed 's/^# //')]($$(basename $$f))"; done; } > reproduce/index.md
+	@echo "-> reproduce/index.md"
+
 clean:
-	rm -rf $(VENV) demo-out .pytest_cache benchmarks/results
+	rm -rf $(VENV) demo-out .pytest_cache benchmarks/results reproduce
