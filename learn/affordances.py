@@ -177,8 +177,9 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
         rows = behaviour_rows(data, b, labels)
         _check_rows(data, b, rows, "training")
         y = labels[rows]
-        if np.unique(y).size < 2:
-            raise DataError(f"behaviour {name!r} has {_one_label(data)}; there is nothing to predict")
+        if (np.unique(y, return_counts=True)[1] >= 2).sum() < 2:  # a lone member cannot be learned from
+            raise DataError(f"behaviour {name!r} has {_one_label(data)} (counting only those of two or more "
+                            "interactions); there is nothing to predict")
         X = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b))
         out[name] = AffordancePredictor(kernel=kernel, cv=folds, n_jobs=n_jobs,
                                         random_state=behaviour_seed(seed, b)).fit(X, y)

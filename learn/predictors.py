@@ -174,6 +174,11 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
                 f"y has {y_idx.size} rows, too few to cross-validate with cv={self.cv}: at least "
                 f"{self.cv} rows must belong to categories with two or more members."
             )
+        if (counts >= 2).sum() < 2:
+            raise DataError(
+                f"y has {counts.size} categories but only {(counts >= 2).sum()} of them with two or more members; "
+                "a predictor needs two such categories to learn from (explore more)."
+            )
         seed = check_random_state(self.random_state).randint(np.iinfo(np.int32).max)
         test_fold = np.full(y_idx.size, -1)
         with warnings.catch_warnings():

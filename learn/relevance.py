@@ -319,6 +319,9 @@ def ranking_prefix(X, y, ranking, estimator=None, cv=3, random_state=None, n_job
     sizes = _prefix_sizes(ranking.size)
 
     def score(k, train, test):
+        seen = np.unique(y_idx[train])
+        if seen.size < 2:  # a category too rare to reach this training fold: it can only say the other
+            return float(np.mean(y_idx[test] == seen[0]))
         cols = ranking[:k]
         model = clone(estimator).fit(X[train][:, cols], y_idx[train])
         return float(np.mean(model.predict(X[test][:, cols]) == y_idx[test]))

@@ -430,3 +430,17 @@ def test_grid_choice_best_or_smoothest_within_one_standard_error():
     assert best["cv_accuracy"] == max(g["accuracy"] for g in best["grid"])
     assert smooth["cv_accuracy"] >= best["cv_accuracy"] - best["cv_accuracy_std"]
     assert (smooth["best_params"]["gamma"], smooth["best_params"]["C"]) <= (best["best_params"]["gamma"], best["best_params"]["C"])
+
+
+def test_a_category_with_one_member_is_ranked_around_and_refused_as_the_only_other():
+    X = np.random.default_rng(0).random((40, 20))
+    y = np.zeros(40, dtype=int)
+    y[0] = 1  # one interaction ended otherwise: no training fold of the cut's cross-validation may see it
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+    from sklearn.svm import LinearSVC
+
+    fr = FeatureRelevance(estimator=make_pipeline(StandardScaler(), LinearSVC(dual=False)), random_state=0).fit(X, y)
+    assert fr.selected_.size >= 1
+    with pytest.raises(ValueError, match="only 1 of them with two or more members"):
+        AffordancePredictor(kernel="linear", cv=5, random_state=0).fit(X, y)
