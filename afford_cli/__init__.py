@@ -1,1 +1,1 @@
-"""afford_cli: the command line, the only package that touches files or the terminal."""
+"""afford: learn what the world affords by playing in it (after Ugur's developmental framework)."""

@@ -1,4 +1,4 @@
-"""The afford command line (python -m afford_cli)."""
-from afford_cli.app import main
+"""The afford command line (python -m afford)."""
+from afford.app import main
 
 main()

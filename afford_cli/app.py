@@ -1,4 +1,4 @@
-"""The ``afford`` command line: wires the commands; each lives in ``afford_cli.commands``.
+"""The ``afford`` command line: wires the commands; each lives in ``afford.commands``.
 
 Exit codes: 0 success, 1 a runtime or data error (one sentence on stderr, ``error: ...``;
 ``AFFORD_DEBUG=1`` shows the traceback), 2 a usage error.
@@ -13,11 +13,11 @@ from typing import Callable
 
 import typer
 
-from afford_cli.commands import (
+from afford.commands import (
     cluster, demo, emulate, evaluate, explore, inspect, plan, predict, scenes, select_features, train,
 )
-from afford_cli.errors import AffordError
-from features.errors import DataError
+from afford.errors import AffordError
+from afford.features.errors import DataError
 
 app = typer.Typer(
     name="afford",

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from afford_cli.errors import AffordError
+from afford.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
@@ -41,7 +41,9 @@ __all__ = [
 FORMAT = "afford"
 #: Bump when the layout changes; teach ``_migrate`` the step from the previous one.
 #: 2: the manifest's own checksum (``manifest.sha256``).
-SCHEMA_VERSION = 2
+#: 3: estimators name their classes by the one import name (``afford.learn.predictors``,
+#: was ``learn.predictors``); :meth:`Artifact.estimator` renames them in older files.
+SCHEMA_VERSION = 3
 MIN_SCHEMA_VERSION = 1
 KINDS = ("interactions", "effects", "features", "model")
 _ZIP_TIME = (1980, 1, 1, 0, 0, 0)
@@ -85,7 +87,44 @@ class Artifact:
         """Load estimator member ``name`` with skops, refusing any type not trusted."""
         if name not in self.blobs:
             raise AffordError(f"{self.source} holds no estimator named {name!r}")
-        return load_estimator(self.blobs[name], f"{self.source}: {name}", trusted)
+        blob = self.blobs[name]
+        if self.manifest.get("schema_version", SCHEMA_VERSION) < 3:
+            blob = _rename_modules(blob, f"{self.source}: {name}")
+        return load_estimator(blob, f"{self.source}: {name}", trusted)
+
+
+#: Packages that were top-level before schema 3 and now live under ``afford``.
+_OLD_PACKAGES = ("sim", "features", "learn", "plan")
+
+
+def _rename_modules(blob: bytes, where: str) -> bytes:
+    """A skops blob from before schema 3 with its classes' modules renamed (``learn.x`` ->
+    ``afford.learn.x``). skops keeps each object's module in ``schema.json``; the rest of
+    the blob is left byte for byte."""
+
+    def rename(node):
+        if isinstance(node, dict):
+            out = {k: rename(v) for k, v in node.items()}
+            module = out.get("__module__")
+            if isinstance(module, str) and module.split(".")[0] in _OLD_PACKAGES:
+                out["__module__"] = f"afford.{module}"
+            return out
+        if isinstance(node, list):
+            return [rename(v) for v in node]
+        return node
+
+    try:
+        with zipfile.ZipFile(io.BytesIO(blob)) as zin:
+            members = [(info, zin.read(info.filename)) for info in zin.infolist()]
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w") as zout:
+            for info, data in members:
+                if info.filename == "schema.json":
+                    data = json.dumps(rename(json.loads(data))).encode()
+                zout.writestr(info, data)
+    except (zipfile.BadZipFile, KeyError, OSError, EOFError, ValueError, UnicodeDecodeError):
+        raise AffordError(f"{where} is not a readable estimator") from None
+    return buf.getvalue()
 
 
 def dump_estimator(estimator) -> bytes:

@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from afford_cli.artifacts import Artifact
-from afford_cli.errors import AffordError
-from features import OUTCOMES, FeatureSchema, Interactions
+from afford.artifacts import Artifact
+from afford.errors import AffordError
+from afford.features import OUTCOMES, FeatureSchema, Interactions
 
 __all__ = ["interactions_members", "interactions_from_artifact", "outcome_table", "behaviour_counts"]
 

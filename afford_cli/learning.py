@@ -12,11 +12,11 @@ from typing import Any
 
 import numpy as np
 
-from afford_cli.artifacts import Artifact, dump_estimator, read_artifact
-from afford_cli.datasets import interactions_from_artifact, interactions_members
-from afford_cli.errors import AffordError
-from features import OUTCOMES, FeatureSchema, Interactions
-from learn import TRUSTED_TYPES as PREDICTOR_TYPES
+from afford.artifacts import Artifact, dump_estimator, read_artifact
+from afford.datasets import interactions_from_artifact, interactions_members
+from afford.errors import AffordError
+from afford.features import OUTCOMES, FeatureSchema, Interactions
+from afford.learn import TRUSTED_TYPES as PREDICTOR_TYPES
 
 __all__ = [
     "TRUSTED", "read_rows", "effects_members", "read_effects", "features_members", "read_selection",
@@ -24,7 +24,7 @@ __all__ = [
 ]
 
 #: Every type a model file may hold; anything else is refused on load.
-TRUSTED = sorted(set(PREDICTOR_TYPES) | {"learn.effects.EffectCategories"})
+TRUSTED = sorted(set(PREDICTOR_TYPES) | {"afford.learn.effects.EffectCategories"})
 
 ROW_KINDS = ("interactions", "effects", "features")
 
@@ -139,7 +139,7 @@ def result_report(data: Interactions, labels: np.ndarray, b: int) -> list[dict]:
 
 def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict | None, selected: dict,
                   predictors: dict, settings: dict, known: dict | None = None) -> tuple[dict, dict, dict]:
-    from learn.affordances import behaviour_rows, known_columns, parameters_of, predictor_inputs
+    from afford.learn.affordances import behaviour_rows, known_columns, parameters_of, predictor_inputs
 
     arrays, blobs, cv, categories = {}, {}, {}, {}
     for b, name in enumerate(data.behavior_names):
@@ -217,7 +217,7 @@ def load_model(path: str) -> LoadedModel:
 
 def forward_model(model: LoadedModel, min_probability: float = 0.02):
     """The planner's forward model of a loaded model artefact."""
-    from plan.forward import BehaviorModel, ForwardModel
+    from afford.plan.forward import BehaviorModel, ForwardModel
 
     behaviors = []
     for b, name in enumerate(model.names):

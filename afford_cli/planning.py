@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from afford_cli.errors import AffordError
-from afford_cli.scenes_io import open_world
+from afford.errors import AffordError
+from afford.scenes_io import open_world
 
 __all__ = ["parse_goals", "plan_once"]
 
 
 def parse_goals(expressions: list[str], schema):
-    from plan.goals import GoalError, parse_goal
+    from afford.plan.goals import GoalError, parse_goal
 
     try:
         return parse_goal(expressions, schema)
@@ -25,8 +25,8 @@ def plan_once(model, fm, scene, specs, seed: int, goal, method: str, limits: dic
     probability with monitoring, the first is the plan (and every replan is chosen the same
     way), and the others are reported under ``alternatives``.
     """
-    from plan.monitor import execute as run
-    from plan.monitor import rank_plans, ranked_planner
+    from afford.plan.monitor import execute as run
+    from afford.plan.monitor import rank_plans, ranked_planner
 
     world = open_world(scene, specs, seed)
     start = world.perceive()

@@ -24,7 +24,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from afford_cli.errors import AffordError
+from afford.errors import AffordError
 
 __all__ = [
     "PlotDir", "plot_directory", "written", "artefact_plots", "evaluation_plots",

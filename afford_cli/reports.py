@@ -53,7 +53,7 @@ def render_categories(console, behavior: str, categories: list[dict], channels: 
 
 def render_outcome_table(console, outcomes: dict) -> None:
     """``{behaviour: {shape: {label: count}}}`` as one table."""
-    from features import OUTCOMES
+    from afford.features import OUTCOMES
 
     ot = Table(title="what physically happened (ground truth, never used to learn)", box=box.SIMPLE_HEAD)
     ot.add_column("behaviour", no_wrap=True)

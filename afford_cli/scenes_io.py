@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from afford_cli.errors import AffordError
-from features.errors import DataError
+from afford.errors import AffordError
+from afford.features.errors import DataError
 
 __all__ = ["make_scene", "scene_layout", "open_world"]
 
@@ -14,8 +14,8 @@ def make_scene(name: str, **options):
     """The registered scene ``name`` with ``options``; unknown names and bad values are one sentence."""
     import typer
 
-    from sim.registry import SceneNotFound, make_scene as make
-    from sim.scene import SceneOptionError
+    from afford.sim.registry import SceneNotFound, make_scene as make
+    from afford.sim.scene import SceneOptionError
 
     try:
         return make(name, **options)
@@ -35,8 +35,8 @@ def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_em
     """
     import typer
 
-    from sim.layout import LayoutError
-    from sim.scene import SceneOptionError, check_options, load_layout_file
+    from afford.sim.layout import LayoutError
+    from afford.sim.scene import SceneOptionError, check_options, load_layout_file
 
     scene = make_scene(scene_name)
     given = {k: v for k, v in drawn.items() if v not in (None, False)}
@@ -67,7 +67,7 @@ def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_em
 
 
 def open_world(scene, specs, seed: int):
-    from sim.session import SimWorld
+    from afford.sim.session import SimWorld
 
     world = SimWorld(scene, specs, seed)
     if world.perceive().shape[0] == 0:

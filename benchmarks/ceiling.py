@@ -51,11 +51,11 @@ def main() -> None:
 
     from sklearn.ensemble import RandomForestClassifier
 
-    from afford_cli.artifacts import read_artifact
-    from afford_cli.datasets import interactions_from_artifact
-    from afford_cli.learning import load_model
-    from learn.affordances import predictor_inputs
-    from learn.predictors import AffordancePredictor
+    from afford.artifacts import read_artifact
+    from afford.datasets import interactions_from_artifact
+    from afford.learning import load_model
+    from afford.learn.affordances import predictor_inputs
+    from afford.learn.predictors import AffordancePredictor
 
     model = load_model(args.model)
     data = interactions_from_artifact(read_artifact(args.data, ("interactions", "effects", "features")))

@@ -30,7 +30,7 @@ def small(shape: str, rng) -> tuple:
 
 
 def start_scene(task: str, i: int, rng):
-    from sim.objects import ObjectSpec
+    from afford.sim.objects import ObjectSpec
 
     shapes = ("box", "cylinder", "sphere")
     if task == "clear":
@@ -63,12 +63,12 @@ def main() -> None:
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "emulate.json"))
     args = ap.parse_args()
 
-    from afford_cli.learning import forward_model, load_model
-    from afford_cli.scenes_io import open_world
-    from plan.emulate import goal_from_observation
-    from plan.monitor import execute, rank_plans, ranked_planner
-    from sim.layout import load_layout
-    from sim.registry import get_scene
+    from afford.learning import forward_model, load_model
+    from afford.scenes_io import open_world
+    from afford.plan.emulate import goal_from_observation
+    from afford.plan.monitor import execute, rank_plans, ranked_planner
+    from afford.sim.layout import load_layout
+    from afford.sim.registry import get_scene
 
     if args.model is None:
         from benchmarks.plan import build_model

@@ -24,15 +24,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._common import emit  # noqa: E402
 
-import features.objects as fobj  # noqa: E402
-import sim.camera as cam  # noqa: E402
-import sim.moves as moves  # noqa: E402
-import sim.robots.mobile as mobile  # noqa: E402
-import sim.scanner as scanner  # noqa: E402
-import sim.traverse as traverse  # noqa: E402
-import sim.world as world  # noqa: E402
-from sim.explore import explore, run_episode  # noqa: E402
-from sim.registry import make_scene  # noqa: E402
+import afford.features.objects as fobj  # noqa: E402
+import afford.sim.camera as cam  # noqa: E402
+import afford.sim.moves as moves  # noqa: E402
+import afford.sim.robots.mobile as mobile  # noqa: E402
+import afford.sim.scanner as scanner  # noqa: E402
+import afford.sim.traverse as traverse  # noqa: E402
+import afford.sim.world as world  # noqa: E402
+from afford.sim.explore import explore, run_episode  # noqa: E402
+from afford.sim.registry import make_scene  # noqa: E402
 
 
 def throughput(scene, n: int, workers: int, seed: int) -> dict:

@@ -21,10 +21,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks._common import emit  # noqa: E402
 
-from afford_cli.artifacts import read_artifact  # noqa: E402
-from afford_cli.datasets import interactions_from_artifact  # noqa: E402
-from afford_cli.learning import learner_settings  # noqa: E402
-from learn.affordances import discover_effects, rank_features, train_predictors  # noqa: E402
+from afford.artifacts import read_artifact  # noqa: E402
+from afford.datasets import interactions_from_artifact  # noqa: E402
+from afford.learning import learner_settings  # noqa: E402
+from afford.learn.affordances import discover_effects, rank_features, train_predictors  # noqa: E402
 
 
 def timed(fn, *a, **k):
@@ -50,8 +50,8 @@ def main() -> None:
         data = interactions_from_artifact(read_artifact(args.data, "interactions"))
         explore_s = None
     else:
-        from sim.explore import explore
-        from sim.registry import get_scene
+        from afford.sim.explore import explore
+        from afford.sim.registry import get_scene
 
         data, explore_s = timed(explore, get_scene("table")(), interactions=args.interactions, seed=args.seed, workers=2)
     (effects, labels), cluster_s = timed(discover_effects, data, seed=0)
@@ -86,8 +86,8 @@ def peak_mb() -> float:
 
 def given_labels(args) -> None:
     """ReliefF (Algorithm 3, m = 1000, 10 hits and misses) with its cut, then the SVMs, on given results."""
-    from sim.explore import explore
-    from sim.registry import make_scene
+    from afford.sim.explore import explore
+    from afford.sim.registry import make_scene
 
     if args.data:
         data, explore_s = interactions_from_artifact(read_artifact(args.data, "interactions")), None

@@ -27,7 +27,7 @@ from benchmarks._common import emit  # noqa: E402
 
 
 def build_model(interactions: int, seed: int) -> str:
-    from afford_cli.app import app
+    from afford.app import app
     from typer.testing import CliRunner
 
     d = Path(tempfile.mkdtemp(prefix="afford-bench-"))
@@ -54,11 +54,11 @@ def main() -> None:
     model_path = args.model or build_model(args.interactions, args.seed)
     build_s = None if args.model else round(time.perf_counter() - t, 1)
 
-    from afford_cli.learning import forward_model, load_model
-    from afford_cli.scenes_io import open_world, scene_layout
-    from plan.goals import parse_goal
-    from plan.monitor import assess, rank_plans
-    from plan.search import best_first
+    from afford.learning import forward_model, load_model
+    from afford.scenes_io import open_world, scene_layout
+    from afford.plan.goals import parse_goal
+    from afford.plan.monitor import assess, rank_plans
+    from afford.plan.search import best_first
 
     model = load_model(model_path)
     goals = {

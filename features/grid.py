@@ -61,9 +61,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from features.detect import RangeImage
-from features.errors import DataError
-from features.schema import Channel, N_ANGLE_BINS, FeatureSchema
+from afford.features.detect import RangeImage
+from afford.features.errors import DataError
+from afford.features.schema import Channel, N_ANGLE_BINS, FeatureSchema
 
 __all__ = [
     "GridSpec",

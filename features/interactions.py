@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from features.errors import DataError
-from features.schema import FeatureSchema
+from afford.features.errors import DataError
+from afford.features.schema import FeatureSchema
 
 __all__ = ["Interactions", "OUTCOMES", "encode_parameters"]
 

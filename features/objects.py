@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from features.detect import Detection, RangeImage, RegionOfInterest, detect_objects
-from features.normals import grid_normals, normal_angles
-from features.schema import N_ANGLE_BINS, object_schema
+from afford.features.detect import Detection, RangeImage, RegionOfInterest, detect_objects
+from afford.features.normals import grid_normals, normal_angles
+from afford.features.schema import N_ANGLE_BINS, object_schema
 
 __all__ = ["object_features", "perceive", "track", "extents", "centres", "N_OBJECT_FEATURES"]
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from features.errors import DataError, NameNotFound
+from afford.features.errors import DataError, NameNotFound
 
 __all__ = ["Channel", "FeatureSchema", "object_schema", "AXES", "N_ANGLE_BINS"]
 

@@ -11,11 +11,11 @@ Per behaviour, as the thesis's chapters 3, 8 and 10 describe:
 4. :func:`evaluate_predictions` and :func:`baseline_scores` measure it on held-out data.
 """
 
-from learn.effects import EffectCategories
-from learn.evaluate import baseline_scores, evaluate_predictions
-from learn.predictors import TRUSTED_TYPES, AffordancePredictor
-from learn.relevance import FeatureRelevance, backward_elimination, feature_groups, forward_selection, relieff
-from learn.xmeans import XMeans, bic_score
+from afford.learn.effects import EffectCategories
+from afford.learn.evaluate import baseline_scores, evaluate_predictions
+from afford.learn.predictors import TRUSTED_TYPES, AffordancePredictor
+from afford.learn.relevance import FeatureRelevance, backward_elimination, feature_groups, forward_selection, relieff
+from afford.learn.xmeans import XMeans, bic_score
 
 __all__ = [
     "AffordancePredictor",

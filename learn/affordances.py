@@ -18,12 +18,12 @@ from typing import Callable
 
 import numpy as np
 
-from features import Interactions
-from features.errors import DataError
-from features.interactions import encode_parameters
-from learn.effects import EffectCategories
-from learn.predictors import AffordancePredictor
-from learn.relevance import FeatureRelevance, feature_groups
+from afford.features import Interactions
+from afford.features.errors import DataError
+from afford.features.interactions import encode_parameters
+from afford.learn.effects import EffectCategories
+from afford.learn.predictors import AffordancePredictor
+from afford.learn.relevance import FeatureRelevance, feature_groups
 
 __all__ = [
     "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",

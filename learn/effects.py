@@ -41,10 +41,10 @@ from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import check_array, check_is_fitted
 
-from features.errors import DataError
-from features.schema import FeatureSchema
-from learn.validation import check_finite
-from learn.xmeans import XMeans
+from afford.features.errors import DataError
+from afford.features.schema import FeatureSchema
+from afford.learn.validation import check_finite
+from afford.learn.xmeans import XMeans
 
 __all__ = ["EffectCategories"]
 

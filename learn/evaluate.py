@@ -15,8 +15,8 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
 
-from features.errors import DataError
-from learn.validation import check_finite
+from afford.features.errors import DataError
+from afford.learn.validation import check_finite
 
 __all__ = ["baseline_scores", "evaluate_predictions", "reliability_bins"]
 

@@ -40,8 +40,8 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from features.errors import DataError
-from learn.validation import check_finite
+from afford.features.errors import DataError
+from afford.learn.validation import check_finite
 
 __all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
 
@@ -50,7 +50,7 @@ __all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
 #: predictors (every calibration method) and checks that ``get_untrusted_types`` reports
 #: exactly these, together.
 TRUSTED_TYPES: list[str] = [
-    "learn.predictors.AffordancePredictor",
+    "afford.learn.predictors.AffordancePredictor",
     "sklearn.calibration._CalibratedClassifier",
     "sklearn.calibration._SigmoidCalibration",
     "sklearn.calibration._TemperatureScaling",

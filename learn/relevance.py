@@ -38,9 +38,9 @@ from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_array, check_is_fitted, validate_data
 
-from features.errors import DataError
-from features.schema import FeatureSchema
-from learn.validation import check_finite
+from afford.features.errors import DataError
+from afford.features.schema import FeatureSchema
+from afford.learn.validation import check_finite
 
 __all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "ranking_prefix", "relieff"]
 

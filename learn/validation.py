@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from features.errors import DataError
+from afford.features.errors import DataError
 
 __all__ = ["check_finite"]
 

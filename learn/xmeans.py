@@ -34,8 +34,8 @@ from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from features.errors import DataError
-from learn.validation import check_finite
+from afford.features.errors import DataError
+from afford.learn.validation import check_finite
 
 __all__ = ["XMeans", "bic_score"]
 

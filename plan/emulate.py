@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from features import FeatureSchema
-from features.errors import DataError
-from plan.goals import Constraint, Goal
+from afford.features import FeatureSchema
+from afford.features.errors import DataError
+from afford.plan.goals import Constraint, Goal
 
 __all__ = ["goal_from_observation"]
 

@@ -18,8 +18,8 @@ from itertools import product
 
 import numpy as np
 
-from features import encode_parameters
-from features.errors import DataError
+from afford.features import encode_parameters
+from afford.features.errors import DataError
 
 __all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE"]
 
@@ -134,7 +134,7 @@ class ForwardModel:
         """The predictor's fast probability function where it has one (same numbers)."""
         key = id(predictor)
         if key not in self._fast:
-            from learn.predictors import AffordancePredictor, fast_predict_proba
+            from afford.learn.predictors import AffordancePredictor, fast_predict_proba
 
             self._fast[key] = (fast_predict_proba(predictor) if isinstance(predictor, AffordancePredictor)
                                else predictor.predict_proba)

@@ -16,8 +16,8 @@ from functools import cached_property
 
 import numpy as np
 
-from features import FeatureSchema
-from features.errors import DataError
+from afford.features import FeatureSchema
+from afford.features.errors import DataError
 
 __all__ = ["Constraint", "Goal", "parse_goal", "GoalError"]
 

@@ -24,10 +24,10 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from plan.forward import ForwardModel
-from plan.forward import SCENE
-from plan.goals import Goal
-from plan.search import UNREACHABLE, Plan, best_plans, search, situation
+from afford.plan.forward import ForwardModel
+from afford.plan.forward import SCENE
+from afford.plan.goals import Goal
+from afford.plan.search import UNREACHABLE, Plan, best_plans, search, situation
 
 __all__ = ["World", "Execution", "assess", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
 

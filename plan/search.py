@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from plan.forward import SCENE, ForwardModel
-from plan.goals import Goal
+from afford.plan.forward import SCENE, ForwardModel
+from afford.plan.goals import Goal
 
 __all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE", "UNREACHABLE"]
 

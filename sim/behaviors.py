@@ -32,11 +32,11 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from features.errors import DataError
-from features.objects import extents
+from afford.features.errors import DataError
+from afford.features.objects import extents
 
 if TYPE_CHECKING:
-    from sim.world import TableWorld
+    from afford.sim.world import TableWorld
 
 __all__ = ["Parameter", "Behavior", "Execution", "TABLE_BEHAVIORS"]
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import open3d as o3d
 
-from features import RangeImage
+from afford.features import RangeImage
 
 __all__ = ["CameraConfig", "RangeCamera", "MeshInstance"]
 

@@ -24,11 +24,11 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from features import Interactions
-from features.errors import DataError
-from features.interactions import OUTCOMES
-from sim.objects import SHAPES
-from sim.world import ObjectTruth, TableWorld
+from afford.features import Interactions
+from afford.features.errors import DataError
+from afford.features.interactions import OUTCOMES
+from afford.sim.objects import SHAPES
+from afford.sim.world import ObjectTruth, TableWorld
 
 __all__ = ["explore", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
            "MOVED", "LIFTED"]

@@ -17,8 +17,8 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from features.errors import DataError
-from sim.objects import SHAPES, ObjectSpec
+from afford.features.errors import DataError
+from afford.sim.objects import SHAPES, ObjectSpec
 
 __all__ = ["LayoutError", "parse_layout", "load_layout", "layout_toml", "read_layout_file"]
 

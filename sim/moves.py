@@ -21,10 +21,10 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from features.errors import DataError
-from features.grid import GridSpec, grid_features, grid_schema
-from sim.behaviors import Behavior, Execution
-from sim.traverse import ROTATIONS, TraverseConfig, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout
+from afford.features.errors import DataError
+from afford.features.grid import GridSpec, grid_features, grid_schema
+from afford.sim.behaviors import Behavior, Execution
+from afford.sim.traverse import ROTATIONS, TraverseConfig, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout
 
 __all__ = ["MOVES", "RESULTS", "TraverseScene", "TraverseSceneConfig", "ScanningWorld", "move_name"]
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import open3d as o3d
 import sapien
-from features.errors import DataError
+from afford.features.errors import DataError
 
 __all__ = ["SHAPES", "ObjectSpec", "box_mesh", "build_object", "object_mesh", "yaw_quaternion"]
 

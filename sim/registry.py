@@ -7,7 +7,7 @@ Importing ``sim.scenes`` registers every scene in it. ``get_scene`` raises
 from __future__ import annotations
 
 from typing import Callable, TypeVar
-from features.errors import DataError, NameNotFound
+from afford.features.errors import DataError, NameNotFound
 
 __all__ = ["register_scene", "get_scene", "scene_names", "make_scene", "SceneNotFound"]
 
@@ -31,7 +31,7 @@ def register_scene(name: str) -> Callable[[T], T]:
 
 
 def _load() -> None:
-    import sim.scenes  # noqa: F401  (registers the scenes)
+    import afford.sim.scenes  # noqa: F401  (registers the scenes)
 
 
 def scene_names() -> list[str]:
@@ -53,7 +53,7 @@ def make_scene(name: str, **options):
     Options the scene does not have raise :class:`sim.scene.SceneOptionError` (a usage
     error); a bad value raises ValueError; both in one sentence.
     """
-    from sim.scene import check_options
+    from afford.sim.scene import check_options
 
     scene = get_scene(name)()
     check_options(scene, options)

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 import open3d as o3d
 
-from features import RangeImage
-from features.errors import DataError
-from sim.camera import MeshInstance
+from afford.features import RangeImage
+from afford.features.errors import DataError
+from afford.sim.camera import MeshInstance
 
 __all__ = ["ScannerConfig", "RangeScanner", "scan_directions"]
 

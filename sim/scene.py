@@ -33,8 +33,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from features.errors import DataError
-from sim.layout import read_layout_file
+from afford.features.errors import DataError
+from afford.sim.layout import read_layout_file
 
 __all__ = ["Scene", "SceneOptionError", "load_layout_file", "LOOPS", "LABEL_SOURCES"]
 

@@ -14,8 +14,8 @@ import numpy as np
 
 from dataclasses import dataclass
 
-from features.errors import DataError
-from sim.explore import Step, interact
+from afford.features.errors import DataError
+from afford.sim.explore import Step, interact
 
 __all__ = ["SimWorld", "Trial"]
 

@@ -65,13 +65,13 @@ from functools import lru_cache
 import numpy as np
 import sapien
 
-from features import RangeImage
-from features.errors import DataError
-from sim.camera import MeshInstance
-from sim.layout import LayoutError
-from sim.objects import SHAPES, ObjectSpec, box_mesh, build_object, object_mesh, yaw_quaternion
-from sim.robots.mobile import MobileRobot, MobileRobotConfig, Odometry
-from sim.scanner import RangeScanner, ScannerConfig
+from afford.features import RangeImage
+from afford.features.errors import DataError
+from afford.sim.camera import MeshInstance
+from afford.sim.layout import LayoutError
+from afford.sim.objects import SHAPES, ObjectSpec, box_mesh, build_object, object_mesh, yaw_quaternion
+from afford.sim.robots.mobile import MobileRobot, MobileRobotConfig, Odometry
+from afford.sim.scanner import RangeScanner, ScannerConfig
 
 __all__ = [
     "Item", "Ramp", "Gap", "TraverseLayout", "TraverseConfig", "TraverseWorld", "ROTATIONS",

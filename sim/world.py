@@ -14,13 +14,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import sapien
 
-from features import RegionOfInterest, perceive, track
-from features.errors import DataError
-from features.objects import N_OBJECT_FEATURES
-from features.objects import centres as object_centres
-from sim.camera import CameraConfig, MeshInstance, RangeCamera
-from sim.hand import Hand, HandConfig
-from sim.objects import ObjectSpec, box_mesh, build_object, object_mesh
+from afford.features import RegionOfInterest, perceive, track
+from afford.features.errors import DataError
+from afford.features.objects import N_OBJECT_FEATURES
+from afford.features.objects import centres as object_centres
+from afford.sim.camera import CameraConfig, MeshInstance, RangeCamera
+from afford.sim.hand import Hand, HandConfig
+from afford.sim.objects import ObjectSpec, box_mesh, build_object, object_mesh
 
 __all__ = ["TableConfig", "TableWorld", "ObjectTruth"]
 

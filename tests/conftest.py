@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features import OUTCOMES
-from sim.explore import Step, interact
-from sim.objects import ObjectSpec
-from sim.registry import get_scene
+from afford.features import OUTCOMES
+from afford.sim.explore import Step, interact
+from afford.sim.objects import ObjectSpec
+from afford.sim.registry import get_scene
 
 
 @pytest.fixture(scope="session")

@@ -9,8 +9,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from afford_cli import artifacts as A
-from afford_cli.errors import AffordError
+from afford import artifacts as A
+from afford.errors import AffordError
 
 
 def _write(tmp_path, kind="interactions", arrays=None, meta=None, **kw):
@@ -220,3 +220,34 @@ def test_missing_file_and_directory(tmp_path):
         A.read_artifact(str(tmp_path))
     with pytest.raises(AffordError, match="does not exist"):
         A.write_artifact(str(tmp_path / "no" / "dir.afford"), b"x")
+
+
+def _old_names(blob: bytes) -> bytes:
+    """A skops blob as afford wrote it before schema 3, when ``learn`` was a top-level package."""
+    with zipfile.ZipFile(io.BytesIO(blob)) as zin:
+        items = [(i.filename, zin.read(i.filename)) for i in zin.infolist()]
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zout:
+        for n, d in items:
+            zout.writestr(n, d.replace(b'"afford.learn.', b'"learn.') if n == "schema.json" else d)
+    return buf.getvalue()
+
+
+def test_schema_2_models_with_the_old_package_names_still_load(tmp_path):
+    from afford.learn import TRUSTED_TYPES, AffordancePredictor
+
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(60, 3))
+    y = (X[:, 0] > 0).astype(int)
+    fitted = AffordancePredictor(kernel="linear", cv=3, random_state=0).fit(X, y)
+    old = _old_names(A.dump_estimator(fitted))
+    assert b'"learn.predictors"' in old and b"afford.learn" not in old
+    path = tmp_path / "old.afford"
+    path.write_bytes(A.artifact_bytes("model", {}, {}, blobs={"predictor": old}))
+    # written by this afford, the old names are not trusted: renaming is for older files only
+    with pytest.raises(AffordError, match="untrusted type learn.predictors.AffordancePredictor"):
+        A.read_artifact(str(path)).estimator("predictor", TRUSTED_TYPES)
+    _rewrite(path, _manifest_edit(reseal=True, schema_version=2))
+    loaded = A.read_artifact(str(path)).estimator("predictor", TRUSTED_TYPES)
+    assert type(loaded) is AffordancePredictor
+    assert np.array_equal(loaded.predict_proba(X), fitted.predict_proba(X))

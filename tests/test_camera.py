@@ -6,8 +6,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from sim.camera import CameraConfig, MeshInstance, RangeCamera
-from sim.objects import ObjectSpec, object_mesh
+from afford.sim.camera import CameraConfig, MeshInstance, RangeCamera
+from afford.sim.objects import ObjectSpec, object_mesh
 
 
 def _sphere(centre, diameter=0.2):
@@ -27,7 +27,7 @@ def test_ranges_are_distances_along_the_ray_not_depth():
 
 
 def test_casting_only_near_moving_bodies_gives_the_full_image():
-    from sim.objects import box_mesh
+    from afford.sim.objects import box_mesh
 
     config = replace(CameraConfig(), noise=0.0)
     v, t = box_mesh((0.35, 0.5, 0.375))

@@ -10,7 +10,7 @@ import sys
 import pytest
 from typer.testing import CliRunner
 
-from afford_cli.app import app
+from afford.app import app
 
 runner = CliRunner()
 
@@ -44,7 +44,7 @@ def test_inspect_reports_an_interactions_file(interactions):
     assert result.exit_code == 0
     info = json.loads(result.stdout)
     assert info["kind"] == "interactions"
-    assert info["schema_version"] == 2
+    assert info["schema_version"] == 3
     assert len(info["sha256"]) == 64 and info["parents"] == []
     assert len(info["features"]) == 43
     assert {f["channel"] for f in info["features"]} == {"visibility", "position", "shape"}
@@ -83,7 +83,7 @@ def test_bad_input_exit_codes(tmp_path, monkeypatch, args, code):
 def _run(*args, stdin=None):
     env = dict(os.environ)
     env.pop("AFFORD_DEBUG", None)
-    return subprocess.run([sys.executable, "-m", "afford_cli", *args], input=stdin, capture_output=True, env=env)
+    return subprocess.run([sys.executable, "-m", "afford", *args], input=stdin, capture_output=True, env=env)
 
 
 def test_errors_are_one_sentence_without_traceback(tmp_path):
@@ -102,7 +102,7 @@ def test_debug_shows_the_traceback(tmp_path):
     bogus = tmp_path / "bogus.afford"
     bogus.write_text("not a zip")
     env = dict(os.environ, AFFORD_DEBUG="1")
-    proc = subprocess.run([sys.executable, "-m", "afford_cli", "inspect", str(bogus)], capture_output=True, env=env)
+    proc = subprocess.run([sys.executable, "-m", "afford", "inspect", str(bogus)], capture_output=True, env=env)
     assert proc.returncode != 0 and b"Traceback" in proc.stderr
 
 
@@ -132,7 +132,7 @@ def test_an_existing_file_survives_a_failed_run(tmp_path, interactions):
     ('[[object]]\nshape = "cone"\nsize = [0.1]\nposition = [0.6, 0.0]\n', "unknown shape 'cone'"),
 ])
 def test_bad_layouts_are_one_sentence(tmp_path, text, message):
-    from sim.layout import LayoutError, load_layout
+    from afford.sim.layout import LayoutError, load_layout
 
     path = tmp_path / "bad.toml"
     path.write_text(text)

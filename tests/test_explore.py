@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from features import OUTCOMES
-from sim.explore import MOVED, explore, run_episode
-from sim.registry import get_scene
+from afford.features import OUTCOMES
+from afford.sim.explore import MOVED, explore, run_episode
+from afford.sim.registry import get_scene
 
 
 def test_episodes_follow_algorithm_5():

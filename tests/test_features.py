@@ -5,16 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features import RangeImage, RegionOfInterest, detect_objects, object_schema, perceive, track
-from features.normals import grid_normals, normal_angles
-from sim.camera import MeshInstance, RangeCamera
-from sim.objects import ObjectSpec, object_mesh
+from afford.features import RangeImage, RegionOfInterest, detect_objects, object_schema, perceive, track
+from afford.features.normals import grid_normals, normal_angles
+from afford.sim.camera import MeshInstance, RangeCamera
+from afford.sim.objects import ObjectSpec, object_mesh
 
 ROI = RegionOfInterest(x=(0.4, 1.1), y=(-0.5, 0.5), z=(0.758, 1.55))
 
 
 def _table_mesh():
-    from sim.objects import box_mesh
+    from afford.sim.objects import box_mesh
 
     v, t = box_mesh((0.35, 0.5, 0.375))
     return MeshInstance(v, t, np.array([0.75, 0.0, 0.375]), np.array([1.0, 0, 0, 0]))
@@ -23,7 +23,7 @@ def _table_mesh():
 def _image(specs, noise=0.003, seed=0):
     from dataclasses import replace
 
-    from sim.camera import CameraConfig
+    from afford.sim.camera import CameraConfig
 
     camera = RangeCamera(replace(CameraConfig(), noise=noise))
     meshes = [_table_mesh()]
@@ -113,7 +113,7 @@ def test_track_prefers_a_visible_object_over_a_vanished_one():
 def test_periodic_parameters_are_seen_as_sine_and_cosine():
     import numpy as np
 
-    from features import encode_parameters
+    from afford.features import encode_parameters
 
     spec = [{"name": "approach", "periodic": True}, {"name": "speed"}]
     near = encode_parameters(np.array([[359.0, 0.5], [1.0, 0.5]]), spec)

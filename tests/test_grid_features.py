@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from features.detect import RangeImage
-from features.grid import (
+from afford.features.detect import RangeImage
+from afford.features.grid import (
     N_CELL_FEATURES,
     GridSpec,
     cell_edges,

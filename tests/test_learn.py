@@ -13,8 +13,8 @@ import skops.io as sio
 from sklearn.metrics import adjusted_rand_score
 from sklearn.utils.estimator_checks import check_estimator
 
-from features import FeatureSchema
-from learn import (
+from afford.features import FeatureSchema
+from afford.learn import (
     TRUSTED_TYPES,
     AffordancePredictor,
     EffectCategories,
@@ -257,7 +257,7 @@ def test_backward_elimination_keeps_planted_group():
 
 
 def test_feature_groups_treat_histograms_as_units():
-    from features import object_schema
+    from afford.features import object_schema
 
     g = feature_groups(object_schema())
     assert len(set(g)) == 1 + 6 + 2
@@ -409,7 +409,7 @@ def test_baseline_scores():
 
 @pytest.mark.parametrize("kernel", ["rbf", "linear"])
 def test_fast_probabilities_equal_predict_proba(kernel):
-    from learn.predictors import fast_predict_proba
+    from afford.learn.predictors import fast_predict_proba
 
     rng = np.random.default_rng(5)
     X = rng.normal(size=(240, 4))

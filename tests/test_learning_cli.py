@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from afford_cli.app import app
-from afford_cli.artifacts import artifact_bytes, read_artifact, write_artifact
-from afford_cli.datasets import interactions_from_artifact, interactions_members
+from afford.app import app
+from afford.artifacts import artifact_bytes, read_artifact, write_artifact
+from afford.datasets import interactions_from_artifact, interactions_members
 
 runner = CliRunner()
 
@@ -64,7 +64,7 @@ def test_model_reports_features_and_predicts(pipeline):
     assert len(info["features"]) == 43 and info["kind"] == "model"
     assert set(info["behaviors"]) == {"push-forward", "push-left", "push-right", "lift"}
     assert all(len(b["selected"]) == 12 for b in info["behaviors"].values())
-    from afford_cli.learning import forward_model, load_model
+    from afford.learning import forward_model, load_model
 
     loaded = load_model(str(pipeline / "model.afford"))
     fm = forward_model(loaded)
@@ -106,7 +106,7 @@ def test_predict_from_a_layout(pipeline, tmp_path):
 
 def test_a_pipe_runs_cluster_select_train(pipeline):
     env = dict(os.environ)
-    cmd = f"{sys.executable} -m afford_cli"
+    cmd = f"{sys.executable} -m afford"
     proc = subprocess.run(
         f"{cmd} cluster {pipeline / 'train.afford'} -o - | {cmd} select-features - -o - --top 8 | "
         f"{cmd} train - -o {pipeline / 'piped.afford'} --kernel linear",
@@ -125,7 +125,7 @@ def _variant(pipeline, tmp_path, name, change):
 
 
 def _unchecked(data):
-    from afford_cli.datasets import behaviour_counts
+    from afford.datasets import behaviour_counts
 
     arrays = {k: getattr(data, k) for k in ("entities", "before_index", "after_index", "behavior", "params", "episode", "step")}
     arrays.update({"truth_" + k: v for k, v in data.truth.items()})
@@ -158,7 +158,7 @@ def test_clear_errors(pipeline, tmp_path):
     ok(["cluster", str(flat), "-o", str(tmp_path / "flat-effects.afford")])
     assert "one effect category only" in _err(["train", str(tmp_path / "flat-effects.afford"), "-o", str(tmp_path / "x")])
 
-    from features import FeatureSchema
+    from afford.features import FeatureSchema
 
     def other_schema(d):
         names = tuple(n if n != "z_max" else "height" for n in d.schema.names)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.objects import ObjectSpec
+from afford.sim.objects import ObjectSpec
 from tests.conftest import act, label
 
 PUSHES = ("push-forward", "push-left", "push-right")

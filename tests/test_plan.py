@@ -7,12 +7,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from features import object_schema
-from plan.emulate import goal_from_observation
-from plan.forward import BehaviorModel, ForwardModel
-from plan.goals import GoalError, parse_goal
-from plan.monitor import assess, execute, rank_plans, reach_probability
-from plan.search import best_first, best_plans, breadth_first, inverse_query, success_probability
+from afford.features import object_schema
+from afford.plan.emulate import goal_from_observation
+from afford.plan.forward import BehaviorModel, ForwardModel
+from afford.plan.goals import GoalError, parse_goal
+from afford.plan.monitor import assess, execute, rank_plans, reach_probability
+from afford.plan.search import best_first, best_plans, breadth_first, inverse_query, success_probability
 
 SCHEMA = object_schema()
 D = len(SCHEMA)
@@ -419,7 +419,7 @@ def test_when_the_goal_needs_an_object_out_of_reach_the_robot_says_so():
 
 
 def test_a_behaviour_without_a_target_moves_every_seen_object_by_its_own_outcome():
-    from plan.forward import SCENE
+    from afford.plan.forward import SCENE
 
     # a mobile robot drives: everything it sees shifts towards it, each object by its own effect
     drive = replace(behaviour("drive", [(0.8, effect(-0.3)), (0.2, effect())]), target=None)

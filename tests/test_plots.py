@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from afford_cli.app import app
-from afford_cli.artifacts import artifact_bytes
-from afford_cli.datasets import interactions_members
-from afford_cli.errors import AffordError
-from afford_cli.plots import artefact_plots, evaluation_plots, plot_directory
-from features import OUTCOMES, Interactions, object_schema
-from learn.evaluate import evaluate_predictions, reliability_bins
+from afford.app import app
+from afford.artifacts import artifact_bytes
+from afford.datasets import interactions_members
+from afford.errors import AffordError
+from afford.plots import artefact_plots, evaluation_plots, plot_directory
+from afford.features import OUTCOMES, Interactions, object_schema
+from afford.learn.evaluate import evaluate_predictions, reliability_bins
 
 runner = CliRunner()
 SCHEMA = object_schema()
@@ -152,5 +152,5 @@ def test_reliability_bins_by_hand():
 
 
 def test_commands_that_do_not_plot_do_not_import_matplotlib():
-    code = "import sys, afford_cli.app; sys.exit('matplotlib' in sys.modules)"
+    code = "import sys, afford.app; sys.exit('matplotlib' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0

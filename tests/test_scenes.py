@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.registry import SceneNotFound, get_scene, scene_names
+from afford.sim.registry import SceneNotFound, get_scene, scene_names
 
 SCENES = scene_names()
 
@@ -30,7 +30,7 @@ def test_scene_docstring_is_a_task_sheet(name):
 
 @pytest.mark.parametrize("name", SCENES)
 def test_scene_follows_the_protocol(name):
-    from sim.scene import LABEL_SOURCES, LOOPS, Scene
+    from afford.sim.scene import LABEL_SOURCES, LOOPS, Scene
 
     scene = get_scene(name)()
     assert isinstance(scene, Scene)
@@ -75,7 +75,7 @@ def test_a_fresh_world_perceives_entities_of_the_schema(name):
 
 @pytest.mark.parametrize("name", SCENES)
 def test_a_fresh_world_per_episode_replays_exactly(name):
-    from sim.explore import run_episode
+    from afford.sim.explore import run_episode
 
     scene = get_scene(name)()
     a = run_episode(scene, seed=3, episode=5)
@@ -91,8 +91,8 @@ def test_a_fresh_world_per_episode_replays_exactly(name):
 
 @pytest.mark.parametrize("name", SCENES)
 def test_an_option_the_scene_lacks_is_refused(name):
-    from sim.registry import make_scene
-    from sim.scene import SceneOptionError
+    from afford.sim.registry import make_scene
+    from afford.sim.scene import SceneOptionError
 
     with pytest.raises(SceneOptionError, match="does not apply to scene"):
         make_scene(name, wheel_count=3)
@@ -126,7 +126,7 @@ def test_sizes_follow_the_configured_range():
 
 
 def test_layouts_must_stand_on_the_table():
-    from sim.objects import ObjectSpec
+    from afford.sim.objects import ObjectSpec
 
     scene = get_scene("table")()
     scene.check_layout([ObjectSpec("box", (0.1, 0.1, 0.1), (0.6, 0.0))])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from afford_cli.app import app
+from afford.app import app
 
 runner = CliRunner()
 TRAVERSE = ("traverse", "traverse-body", "traverse-gaps", "traverse-ramps")
@@ -57,7 +57,7 @@ def test_exploration_records_given_results_on_3900_grid_features(learned):
 
 
 def test_an_environment_is_stored_once_for_its_seven_moves(learned):
-    from afford_cli.artifacts import read_artifact
+    from afford.artifacts import read_artifact
 
     art = read_artifact(str(learned / "train.afford"))
     assert art.arrays["entities"].shape == (36, 3900) and art.arrays["entities"].dtype == np.float32
@@ -105,8 +105,8 @@ def test_commands_refuse_what_does_not_apply_in_one_sentence(learned, tmp_path):
 
 
 def test_a_goal_on_a_feature_the_schema_lacks_is_refused(learned):
-    from plan.goals import GoalError, parse_goal
-    from sim.registry import make_scene
+    from afford.plan.goals import GoalError, parse_goal
+    from afford.sim.registry import make_scene
 
     schema = make_scene("traverse").schema
     with pytest.raises(GoalError, match="unknown feature 'z_min'"):
@@ -122,7 +122,7 @@ EXAMPLES = {"box-ahead": "fail", "ball-ahead": "success", "bar-low": "fail", "ba
 def test_the_example_layouts_do_what_their_comments_say(name):
     from pathlib import Path
 
-    from afford_cli.scenes_io import open_world, scene_layout
+    from afford.scenes_io import open_world, scene_layout
 
     path = Path(__file__).parents[1] / "examples" / "layouts" / "traverse" / f"{name}.toml"
     scene, layout = scene_layout("traverse", None, str(path))

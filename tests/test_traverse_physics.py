@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from sim.layout import LayoutError
-from sim.traverse import (
+from afford.sim.layout import LayoutError
+from afford.sim.traverse import (
     ROTATIONS, Gap, Item, Ramp, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout,
     sample_body, sample_clutter, sample_gap, sample_ramp,
 )

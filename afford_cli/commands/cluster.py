@@ -8,11 +8,11 @@ from typing import Annotated, Optional
 
 import typer
 
-from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.errors import AffordError
-from afford_cli.learning import effects_members, read_rows
-from afford_cli.options import InputPath, Json, OutputPath, Seed
-from afford_cli.output import Output
+from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.errors import AffordError
+from afford.learning import effects_members, read_rows
+from afford.options import InputPath, Json, OutputPath, Seed
+from afford.output import Output
 
 
 class Method(str, Enum):
@@ -37,7 +37,7 @@ def cluster(
     json: Json = False,
 ) -> None:
     """Discover effect categories per behaviour, without labels (thesis 8.4.1, Algorithm 7)."""
-    from learn.affordances import discover_effects
+    from afford.learn.affordances import discover_effects
 
     if k is not None and method is not Method.kmeans:
         raise typer.BadParameter("--k goes with --method kmeans")
@@ -59,7 +59,7 @@ def cluster(
                                    "categories": s["categories"]} for name, s in meta["effects"].items()}}
 
     def render(console):
-        from afford_cli.reports import render_categories
+        from afford.reports import render_categories
 
         for name, s in meta["effects"].items():
             render_categories(console, name, s["categories"], [(ch, [data.schema.names[i] for i in idx]) for ch, idx in data.schema.channel_groups()])

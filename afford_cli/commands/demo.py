@@ -11,8 +11,8 @@ from typing import Annotated
 
 import typer
 
-from afford_cli.options import Seed, Workers
-from afford_cli.output import Output
+from afford.options import Seed, Workers
+from afford.output import Output
 
 
 def demo(
@@ -23,8 +23,8 @@ def demo(
     workers: Workers = 2,
 ) -> None:
     """Explore the table scene, learn its affordances, measure them, plan and emulate; then the mobile robot."""
-    from afford_cli.scenes_io import make_scene
-    from afford_cli.commands import cluster, emulate, evaluate, explore, inspect, plan, predict, select_features, train
+    from afford.scenes_io import make_scene
+    from afford.commands import cluster, emulate, evaluate, explore, inspect, plan, predict, select_features, train
 
     out_dir.mkdir(parents=True, exist_ok=True)
     console = Output().report

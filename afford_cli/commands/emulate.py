@@ -7,13 +7,13 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from afford_cli.commands.plan import render_plan
-from afford_cli.errors import AffordError
-from features.errors import DataError
-from afford_cli.learning import forward_model, load_model
-from afford_cli.options import Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
-from afford_cli.output import Output
-from afford_cli.scenes_io import open_world, scene_layout
+from afford.commands.plan import render_plan
+from afford.errors import AffordError
+from afford.features.errors import DataError
+from afford.learning import forward_model, load_model
+from afford.options import Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
+from afford.output import Output
+from afford.scenes_io import open_world, scene_layout
 
 
 def emulate(
@@ -30,9 +30,9 @@ def emulate(
     json: Json = False,
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
-    from plan.emulate import goal_from_observation
-    from plan.monitor import execute as run
-    from plan.monitor import rank_plans, ranked_planner
+    from afford.plan.emulate import goal_from_observation
+    from afford.plan.monitor import execute as run
+    from afford.plan.monitor import rank_plans, ranked_planner
 
     loaded = load_model(model)
     loaded.check_effects("emulation")

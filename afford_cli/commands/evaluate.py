@@ -7,21 +7,21 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from afford_cli.artifacts import read_artifact
-from afford_cli.datasets import interactions_from_artifact
-from afford_cli.errors import AffordError
-from afford_cli.learning import load_model
-from afford_cli.options import Json, Seed
-from afford_cli.output import Output
-from afford_cli.plots import PlotDir, evaluation_plots, plot_directory, written
-from afford_cli.reports import render_metrics
+from afford.artifacts import read_artifact
+from afford.datasets import interactions_from_artifact
+from afford.errors import AffordError
+from afford.learning import load_model
+from afford.options import Json, Seed
+from afford.output import Output
+from afford.plots import PlotDir, evaluation_plots, plot_directory, written
+from afford.reports import render_metrics
 
 
 def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
     """Per behaviour: accuracy, log loss, Brier, ECE, confusion, reliability bins (and baselines)."""
-    from learn import baseline_scores, evaluate_predictions
-    from learn.affordances import predictor_inputs
-    from learn.evaluate import reliability_bins
+    from afford.learn import baseline_scores, evaluate_predictions
+    from afford.learn.affordances import predictor_inputs
+    from afford.learn.evaluate import reliability_bins
 
     model.check_schema(data.schema, "the data")
     missing = [n for n in model.names if n not in data.behavior_names]

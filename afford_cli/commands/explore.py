@@ -6,19 +6,19 @@ import time
 from typing import Annotated, Optional
 
 import typer
-from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.datasets import behaviour_counts, interactions_members, outcome_table, result_rates
-from afford_cli.reports import render_outcome_table, render_result_rates
-from afford_cli.scenes_io import make_scene
-from afford_cli.errors import AffordError
-from afford_cli.options import Json, OutputPath, SceneName, Seed, Workers
-from afford_cli.output import Output
+from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.datasets import behaviour_counts, interactions_members, outcome_table, result_rates
+from afford.reports import render_outcome_table, render_result_rates
+from afford.scenes_io import make_scene
+from afford.errors import AffordError
+from afford.options import Json, OutputPath, SceneName, Seed, Workers
+from afford.output import Output
 
 
 def run_explore(out: Output, scene, *, episodes: int | None, interactions: int | None, seed: int,
                 workers: int, max_steps: int | None = None):
     """Explore with a progress bar; returns (data, seconds)."""
-    from sim.explore import explore as run
+    from afford.sim.explore import explore as run
 
     total = episodes if episodes is not None else interactions
     unit = "episodes" if episodes is not None else "interactions"

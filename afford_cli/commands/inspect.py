@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from rich.table import Table
 
-from afford_cli.artifacts import Artifact, read_artifact
-from afford_cli.errors import AffordError
-from afford_cli.datasets import behaviour_counts, interactions_from_artifact, outcome_table
-from afford_cli.options import InputPath, Json
-from afford_cli.output import Output
-from afford_cli.plots import PlotDir, artefact_plots, plot_directory, written
-from afford_cli.reports import render_categories, render_outcome_table, render_result_rates
-from features import FeatureSchema
+from afford.artifacts import Artifact, read_artifact
+from afford.errors import AffordError
+from afford.datasets import behaviour_counts, interactions_from_artifact, outcome_table
+from afford.options import InputPath, Json
+from afford.output import Output
+from afford.plots import PlotDir, artefact_plots, plot_directory, written
+from afford.reports import render_categories, render_outcome_table, render_result_rates
+from afford.features import FeatureSchema
 
 
 def describe(art: Artifact) -> dict:

@@ -9,16 +9,16 @@ import typer
 from rich import box
 from rich.table import Table
 
-from afford_cli.errors import AffordError
-from features.errors import DataError
-from afford_cli.learning import forward_model, load_model
-from afford_cli.options import (
+from afford.errors import AffordError
+from afford.features.errors import DataError
+from afford.learning import forward_model, load_model
+from afford.options import (
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
 )
-from afford_cli.output import Output
-from afford_cli.planning import parse_goals, plan_once
-from afford_cli.scenes_io import make_scene, scene_layout
-from plan.report import summarise
+from afford.output import Output
+from afford.planning import parse_goals, plan_once
+from afford.scenes_io import make_scene, scene_layout
+from afford.plan.report import summarise
 
 
 class SearchMethod(str, Enum):

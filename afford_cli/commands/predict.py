@@ -16,10 +16,10 @@ import typer
 from rich import box
 from rich.table import Table
 
-from afford_cli.learning import forward_model, load_model
-from afford_cli.options import Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
-from afford_cli.output import Output
-from afford_cli.scenes_io import open_world, scene_layout
+from afford.learning import forward_model, load_model
+from afford.options import Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
+from afford.output import Output
+from afford.scenes_io import open_world, scene_layout
 
 #: Geometry features shown per entity, at most (an environment of 3900 features shows none).
 _SHOWN = 12
@@ -35,7 +35,7 @@ def _named(schema, f: np.ndarray) -> dict:
 def predictions(model, fm, state: np.ndarray) -> list[dict]:
     """For each perceived entity and behaviour: the probabilities and, where effects are
     predicted, the most probable category's next entity."""
-    from plan.forward import SCENE
+    from afford.plan.forward import SCENE
 
     schema = model.schema
     out = []
@@ -64,7 +64,7 @@ def predictions(model, fm, state: np.ndarray) -> list[dict]:
 
 def check(model, scene, layout, seed: int, preds: list[dict]) -> None:
     """Run each behaviour from the same start in the simulator; did the prediction hold?"""
-    from features import OUTCOMES
+    from afford.features import OUTCOMES
 
     for entry in preds:
         for name, p in entry["behaviors"].items():
@@ -107,8 +107,8 @@ def predict(
         check(loaded, sc, specs, seed or 0, preds)
     result = {"objects": preds, "layout": sc.layout_json(specs), "label_source": loaded.label_source}
     if want:
-        from afford_cli.planning import parse_goals
-        from plan.search import inverse_query
+        from afford.planning import parse_goals
+        from afford.plan.search import inverse_query
 
         goal = parse_goals(want, loaded.schema)
         goal.check_objects(state.shape[0])

@@ -4,13 +4,13 @@ from __future__ import annotations
 
 from rich.table import Table
 
-from afford_cli.options import Json
-from afford_cli.output import Output
+from afford.options import Json
+from afford.output import Output
 
 
 def scenes(json: Json = False) -> None:
     """List the registered scenes, what they are, and the behaviours the robot has in them."""
-    from sim.registry import get_scene, scene_names
+    from afford.sim.registry import get_scene, scene_names
 
     items = []
     for name in scene_names():

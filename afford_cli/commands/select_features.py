@@ -9,10 +9,10 @@ from typing import Annotated, Optional
 import typer
 from rich.table import Table
 
-from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.learning import features_members, learner_settings, read_effects, read_rows
-from afford_cli.options import InputPath, Json, KernelOption, OutputPath, Seed
-from afford_cli.output import Output
+from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.learning import features_members, learner_settings, read_effects, read_rows
+from afford.options import InputPath, Json, KernelOption, OutputPath, Seed
+from afford.output import Output
 
 
 class Method(str, Enum):
@@ -32,7 +32,7 @@ def select_features(
     json: Json = False,
 ) -> None:
     """Rank the entity features by relevance to each behaviour's labels (effect categories, or given results)."""
-    from learn.affordances import rank_features
+    from afford.learn.affordances import rank_features
 
     check_output(output)
     out = Output(json, stdout_busy=output == "-")

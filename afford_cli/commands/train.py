@@ -8,10 +8,10 @@ from typing import Annotated, Optional
 import typer
 from rich.table import Table
 
-from afford_cli.artifacts import artifact_bytes, check_output, write_artifact
-from afford_cli.learning import learner_settings, model_members, read_effects, read_rows, read_selection
-from afford_cli.options import InputPath, Json, KernelOption, OutputPath, Seed
-from afford_cli.output import Output
+from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.learning import learner_settings, model_members, read_effects, read_rows, read_selection
+from afford.options import InputPath, Json, KernelOption, OutputPath, Seed
+from afford.output import Output
 
 
 def train(
@@ -23,7 +23,7 @@ def train(
     json: Json = False,
 ) -> None:
     """Train each behaviour's predictor of its labels (effect categories or given results), probabilities calibrated."""
-    from learn.affordances import train_known, train_predictors
+    from afford.learn.affordances import train_known, train_predictors
 
     check_output(output)
     out = Output(json, stdout_busy=output == "-")

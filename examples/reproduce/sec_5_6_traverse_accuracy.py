@@ -43,11 +43,11 @@ def commit() -> str:
 
 
 def scene_rows(name: str, args) -> list[dict]:
-    from afford_cli.learning import learner_settings
-    from learn import baseline_scores
-    from learn.affordances import parameters_of, predictor_inputs, rank_features, train_predictors
-    from sim.explore import explore
-    from sim.registry import make_scene
+    from afford.learning import learner_settings
+    from afford.learn import baseline_scores
+    from afford.learn.affordances import parameters_of, predictor_inputs, rank_features, train_predictors
+    from afford.sim.explore import explore
+    from afford.sim.registry import make_scene
 
     scene = make_scene(name)
     size = ({"episodes": 60}, {"episodes": 20}) if args.quick else ({"interactions": 5000}, {"interactions": 1400})
@@ -120,7 +120,7 @@ def main() -> None:
     unknown = [s for s in names if s not in THESIS]
     if unknown:
         sys.exit(f"error: {unknown[0]!r} is not a traverse scene; choose from {', '.join(THESIS)}")
-    from features.errors import DataError
+    from afford.features.errors import DataError
 
     try:
         rows = [r for name in names for r in scene_rows(name, args)]

@@ -56,7 +56,7 @@ from typing import Callable
 import numpy as np
 import sapien
 
-from sim.objects import yaw_quaternion
+from afford.sim.objects import yaw_quaternion
 
 __all__ = ["MobileRobotConfig", "MobileRobot", "Odometry", "Pose2D", "WHEELS"]
 

@@ -34,14 +34,14 @@ import numpy as np
 
 from dataclasses import replace
 
-from features import object_schema
-from features.errors import DataError
-from sim.behaviors import TABLE_BEHAVIORS
-from sim.camera import RangeCamera
-from sim.layout import layout_toml, parse_layout
-from sim.objects import SHAPES, ObjectSpec
-from sim.registry import register_scene
-from sim.world import TableConfig, TableWorld
+from afford.features import object_schema
+from afford.features.errors import DataError
+from afford.sim.behaviors import TABLE_BEHAVIORS
+from afford.sim.camera import RangeCamera
+from afford.sim.layout import layout_toml, parse_layout
+from afford.sim.objects import SHAPES, ObjectSpec
+from afford.sim.registry import register_scene
+from afford.sim.world import TableConfig, TableWorld
 
 __all__ = ["TableScene", "TableSceneConfig"]
 

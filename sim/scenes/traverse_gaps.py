@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.moves import TraverseScene
-from sim.registry import register_scene
-from sim.traverse import TraverseLayout, sample_gap
+from afford.sim.moves import TraverseScene
+from afford.sim.registry import register_scene
+from afford.sim.traverse import TraverseLayout, sample_gap
 
 __all__ = ["GapScene"]
 
