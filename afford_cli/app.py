@@ -9,7 +9,7 @@ from __future__ import annotations
 import functools
 import os
 import sys
-from typing import Callable
+from typing import Annotated, Callable
 
 import typer
 
@@ -26,6 +26,22 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        from afford import __version__
+
+        typer.echo(f"afford {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: Annotated[bool, typer.Option("--version", callback=_show_version, is_eager=True,
+                                          help="Print afford's version and exit.")] = False,
+) -> None:
+    """Learn what objects afford by playing with them in simulation (after Ugur's thesis)."""
 
 
 def _guarded(command: Callable) -> Callable:

@@ -51,12 +51,9 @@ _SEAL = "manifest.sha256"
 
 
 def _version() -> str:
-    try:
-        from importlib.metadata import version
+    from afford import __version__
 
-        return version("afford")
-    except Exception:  # pragma: no cover - running from a source tree without install
-        return "0+unknown"
+    return __version__
 
 
 def _sha256(data: bytes) -> str:

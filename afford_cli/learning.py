@@ -211,8 +211,11 @@ class LoadedModel:
                               f"against {len(self.schema)}); use data perceived the way the model's were")
 
 
-def load_model(path: str) -> LoadedModel:
-    return LoadedModel(read_artifact(path, "model"))
+def load_model(path: str):
+    """The model artefact at ``path``, as the API's :class:`afford.api.Model`."""
+    from afford.api import Model
+
+    return Model(read_artifact(path, "model"))
 
 
 def forward_model(model: LoadedModel, min_probability: float = 0.02):

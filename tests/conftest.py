@@ -12,6 +12,28 @@ from afford.sim.registry import get_scene
 
 
 @pytest.fixture(scope="session")
+def pipeline(tmp_path_factory):
+    """A small table pipeline, made once: train/test interactions, effects, features, model."""
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    runner = CliRunner()
+
+    def ok(args):
+        result = runner.invoke(app, args)
+        assert result.exit_code == 0, (args, result.output)
+
+    d = tmp_path_factory.mktemp("learn")
+    ok(["explore", "--interactions", "480", "--seed", "4", "--workers", "2", "-o", str(d / "train.afford")])
+    ok(["explore", "--interactions", "160", "--seed", "5", "--workers", "2", "-o", str(d / "test.afford")])
+    ok(["cluster", str(d / "train.afford"), "-o", str(d / "effects.afford"), "--seed", "1"])
+    ok(["select-features", str(d / "effects.afford"), "-o", str(d / "features.afford"), "--top", "12"])
+    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
+    return d
+
+
+@pytest.fixture(scope="session")
 def table():
     return get_scene("table")()
 

@@ -24,17 +24,6 @@ def ok(args):
     return result
 
 
-@pytest.fixture(scope="module")
-def pipeline(tmp_path_factory):
-    d = tmp_path_factory.mktemp("learn")
-    ok(["explore", "--interactions", "480", "--seed", "4", "--workers", "2", "-o", str(d / "train.afford")])
-    ok(["explore", "--interactions", "160", "--seed", "5", "--workers", "2", "-o", str(d / "test.afford")])
-    ok(["cluster", str(d / "train.afford"), "-o", str(d / "effects.afford"), "--seed", "1"])
-    ok(["select-features", str(d / "effects.afford"), "-o", str(d / "features.afford"), "--top", "12"])
-    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
-    return d
-
-
 def test_each_artefact_names_its_parent(pipeline):
     chain = ["train", "effects", "features", "model"]
     arts = {name: read_artifact(str(pipeline / f"{name}.afford")) for name in chain}

@@ -10,7 +10,7 @@ import typer
 from afford.commands.plan import render_plan
 from afford.errors import AffordError
 from afford.features.errors import DataError
-from afford.learning import forward_model, load_model
+from afford.learning import load_model
 from afford.options import Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
 from afford.output import Output
 from afford.scenes_io import open_world, scene_layout
@@ -31,12 +31,8 @@ def emulate(
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
     from afford.plan.emulate import goal_from_observation
-    from afford.plan.monitor import execute as run
-    from afford.plan.monitor import rank_plans, ranked_planner
-
     loaded = load_model(model)
     loaded.check_effects("emulation")
-    fm = forward_model(loaded)
     sc, shown = scene_layout(scene, None, observe, allow_empty=True)
     _, specs = scene_layout(scene, None, start)
     observed = open_world(sc, shown, seed).perceive() if shown else np.empty((0, len(loaded.schema)))
@@ -48,7 +44,7 @@ def emulate(
     except DataError as exc:
         raise AffordError(str(exc)) from None
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}
-    ranked = rank_plans(fm, state, goal, alternatives, max_replans=max_replans, **limits)
+    ranked = loaded.plans(state, goal, alternatives=alternatives, max_replans=max_replans, **limits)
     plan = ranked[0]
     result = {"goal": goal.to_json(), "plan": plan.to_json()["steps"], "found": plan.found,
               "success_probability": round(plan.success_probability, 4),
@@ -58,8 +54,7 @@ def emulate(
     if alternatives > 1:
         result["alternatives"] = entry["alternatives"] = [p.to_json() for p in ranked[1:]]
     if execute and plan.found:
-        ex = run(world, fm, goal, max_replans=max_replans, first=plan,
-                 planner=ranked_planner(fm, goal, alternatives, max_replans=max_replans, **limits), **limits)
+        ex = loaded.execute(world, goal, first=plan, alternatives=alternatives, max_replans=max_replans, **limits)
         result.update({"reached": ex.reached, "replans": ex.replans, "execution": ex.to_json()})
         entry["execution"] = ex.to_json()
     elif not plan.found:

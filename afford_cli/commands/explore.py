@@ -6,11 +6,10 @@ import time
 from typing import Annotated, Optional
 
 import typer
-from afford.artifacts import artifact_bytes, check_output, write_artifact
-from afford.datasets import behaviour_counts, interactions_members, outcome_table, result_rates
+from afford.artifacts import check_output
+from afford.datasets import behaviour_counts, outcome_table, result_rates
 from afford.reports import render_outcome_table, render_result_rates
 from afford.scenes_io import make_scene
-from afford.errors import AffordError
 from afford.options import Json, OutputPath, SceneName, Seed, Workers
 from afford.output import Output
 
@@ -18,7 +17,7 @@ from afford.output import Output
 def run_explore(out: Output, scene, *, episodes: int | None, interactions: int | None, seed: int,
                 workers: int, max_steps: int | None = None):
     """Explore with a progress bar; returns (data, seconds)."""
-    from afford.sim.explore import explore as run
+    from afford.api import explore as run
 
     total = episodes if episodes is not None else interactions
     unit = "episodes" if episodes is not None else "interactions"
@@ -48,12 +47,11 @@ def summary(data, seconds: float) -> dict:
 def record(out: Output, scene, output: str, *, episodes: int | None, interactions: int | None, seed: int,
            workers: int, max_steps: int | None = None):
     """Explore, write the ``interactions`` artefact to ``output``; returns (data, summary)."""
+    from afford.api import save
+
     data, seconds = run_explore(out, scene, episodes=episodes, interactions=interactions, seed=seed,
                                 workers=workers, max_steps=max_steps)
-    if len(data) == 0:
-        raise AffordError("exploration recorded no interactions (no object was ever seen)")
-    arrays, meta = interactions_members(data)
-    write_artifact(output, artifact_bytes("interactions", arrays, meta, seed=seed))
+    save(data, output, seed=seed)
     result = summary(data, seconds)
     result["output"] = output
     return data, result

@@ -11,12 +11,13 @@ from rich.table import Table
 
 from afford.errors import AffordError
 from afford.features.errors import DataError
-from afford.learning import forward_model, load_model
+from afford.learning import load_model
 from afford.options import (
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
 )
 from afford.output import Output
-from afford.planning import parse_goals, plan_once
+from afford.api import parse_goal
+from afford.planning import plan_once
 from afford.scenes_io import make_scene, scene_layout
 from afford.plan.report import summarise
 
@@ -85,8 +86,7 @@ def plan(
                        episodes=episodes if episodes > 1 else None)
     loaded = load_model(model)
     loaded.check_effects("planning")
-    fm = forward_model(loaded)
-    g = parse_goals(goal, loaded.schema)
+    g = parse_goal(goal, loaded.schema)
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}
     out = Output(json)
     base = seed or 0
@@ -95,13 +95,13 @@ def plan(
     loaded.check_schema(make_scene(scene).schema, "this scene's perception")
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable)
-        entries.append(plan_once(loaded, fm, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives))
+        entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
                 sc, specs = scene_layout(scene, base + e, None, objects=objects, reachable=reachable)
                 try:
-                    entries.append(plan_once(loaded, fm, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
+                    entries.append(plan_once(loaded, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
                 except (AffordError, DataError) as exc:  # e.g. an object hidden behind another
                     entries.append({"seed": base + e, "skipped": str(exc),
                                     "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})

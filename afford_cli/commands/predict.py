@@ -1,7 +1,7 @@
 """``afford predict``: perceive a scene, predict what every behaviour would do.
 
 The probabilities and next states are the planner's forward model's
-(:class:`plan.forward.ForwardModel`), so ``predict`` and ``plan`` report the same numbers
+(:class:`afford.plan.forward.ForwardModel`, through :meth:`afford.api.Model.predictions`), so ``predict`` and ``plan`` report the same numbers
 for the same step. A model whose labels were given (chapter 5: success or fail) predicts
 the result of each behaviour; one whose categories were discovered predicts the effect
 category and the entity it leaves behind.
@@ -11,56 +11,14 @@ from __future__ import annotations
 
 from typing import Annotated, Optional
 
-import numpy as np
 import typer
 from rich import box
 from rich.table import Table
 
-from afford.learning import forward_model, load_model
+from afford.learning import load_model
 from afford.options import Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
 from afford.output import Output
 from afford.scenes_io import open_world, scene_layout
-
-#: Geometry features shown per entity, at most (an environment of 3900 features shows none).
-_SHOWN = 12
-
-
-def _named(schema, f: np.ndarray) -> dict:
-    cols = schema.geometry
-    if cols.size > _SHOWN:
-        return {}
-    return {schema.names[i]: round(float(f[i]), 4) for i in cols}
-
-
-def predictions(model, fm, state: np.ndarray) -> list[dict]:
-    """For each perceived entity and behaviour: the probabilities and, where effects are
-    predicted, the most probable category's next entity."""
-    from afford.plan.forward import SCENE
-
-    schema = model.schema
-    out = []
-    for i, f in enumerate(state):
-        seen = bool(schema.visible(f))
-        entry = {"object": i, "visible": seen, "features": _named(schema, f), "behaviors": {}}
-        if seen:
-            for b, name in enumerate(model.names):
-                classes, proba = fm.distribution(f, b, ())
-                best = int(classes[np.argmax(proba)])
-                p = {"category": best, "probability": round(float(proba.max()), 4),
-                     "probabilities": {str(int(c)): round(float(q), 4) for c, q in zip(classes, proba)},
-                     # an effect of a kind the model discarded as rare (P(known) < 1), which no plan counts on
-                     "unknown": round(max(0.0, 1.0 - float(proba.sum())), 4)}
-                if model.label_source == "given":
-                    p["result"] = model.result_names[best]
-                else:
-                    obj = SCENE if fm.behaviors[b].target is None else i
-                    cats = [best if j == i else None for j in range(state.shape[0])] if obj == SCENE else best
-                    nxt = fm.apply(state, obj, b, cats)[i]
-                    p["next"] = {"visible": bool(schema.visible(nxt)), "features": _named(schema, nxt)}
-                entry["behaviors"][name] = p
-        out.append(entry)
-    return out
-
 
 def check(model, scene, layout, seed: int, preds: list[dict]) -> None:
     """Run each behaviour from the same start in the simulator; did the prediction hold?"""
@@ -101,19 +59,16 @@ def predict(
     world = open_world(sc, specs, seed or 0)
     state = world.perceive()
     loaded.check_schema(sc.schema, "this scene's perception")
-    fm = forward_model(loaded, min_probability=0.0)
-    preds = predictions(loaded, fm, state)
+    preds = loaded.predictions(state)
     if run_check:
         check(loaded, sc, specs, seed or 0, preds)
     result = {"objects": preds, "layout": sc.layout_json(specs), "label_source": loaded.label_source}
     if want:
-        from afford.planning import parse_goals
-        from afford.plan.search import inverse_query
+        from afford.api import parse_goal
 
-        goal = parse_goals(want, loaded.schema)
-        goal.check_objects(state.shape[0])
+        goal = parse_goal(want, loaded.schema)
         result["want"] = goal.to_json()
-        result["ranking"] = inverse_query(fm, state, goal)
+        result["ranking"] = loaded.inverse(state, goal)
     if run_check:
         checks = [p["held"] for e in preds for p in e["behaviors"].values()]
         result["held"] = int(sum(checks))

@@ -1,0 +1,288 @@
+"""The Python API: what the command line does, callable from a script or a notebook.
+
+Every command runs through these functions, so a script and ``afford ...`` give the same
+numbers for the same inputs::
+
+    import afford
+
+    data = afford.explore("table", episodes=20, seed=1)      # Interactions
+    afford.save(data, "i.afford", seed=1)
+    data = afford.load_interactions("i.afford")
+    X, names = data.before_rows(), data.schema.names        # arrays with feature names
+
+    model = afford.load_model("m.afford")                    # after cluster | select-features | train
+    classes, p = model.predict_proba("push-forward", X[:5])  # calibrated, rows may sum below 1
+    world = afford.world("table", seed=3)                   # a scene to act in
+    plan = model.plan(world.perceive(), "0:x>0.15")          # best of three candidate plans
+    run = model.execute(world, "0:x>0.15")                    # plan, act, monitor, replan
+
+Errors are :class:`AffordError` (a refused file, an impossible request) or
+:class:`afford.features.errors.DataError` (bad values), each one sentence.
+"""
+
+from __future__ import annotations
+
+from typing import Callable, Sequence
+
+import numpy as np
+
+from afford.errors import AffordError
+from afford.learning import LoadedModel, read_effects, read_rows
+from afford.artifacts import read_artifact
+
+__all__ = [
+    "AffordError", "load", "load_interactions", "load_labels", "load_model", "save", "Model",
+    "scene_names", "make_scene", "explore", "world", "parse_goal",
+]
+
+
+def load(path: str):
+    """Any artefact: a :class:`Model` for a model file, the :class:`Interactions` of any
+    other (interactions, effects, features). ``-`` reads standard input."""
+    art = read_artifact(path)
+    if art.kind == "model":
+        return Model(art)
+    from afford.datasets import interactions_from_artifact
+
+    return interactions_from_artifact(art)
+
+
+def load_interactions(path: str):
+    """The interaction rows of an interactions, effects or features artefact."""
+    return read_rows(path)[1]
+
+
+def load_labels(path: str) -> np.ndarray:
+    """Each row's label: the effect category ``cluster`` gave it (-1: pruned as rare), or the
+    robot's own result where the labels were given (chapters 5-6)."""
+    art, data = read_rows(path)
+    return read_effects(art, data)[0]
+
+
+def load_model(path: str) -> "Model":
+    """A model artefact with its predictors loaded (only trusted types are ever built)."""
+    from afford.learning import load_model as load
+
+    return load(path)
+
+
+def save(data, path: str, *, seed: int | None = None) -> None:
+    """Write interactions to an ``interactions`` artefact (atomically; ``-`` is stdout)."""
+    from afford.artifacts import artifact_bytes, write_artifact
+    from afford.datasets import interactions_members
+
+    if len(data) == 0:
+        raise AffordError("there are no interactions to save")
+    arrays, meta = interactions_members(data)
+    write_artifact(path, artifact_bytes("interactions", arrays, meta, seed=seed))
+
+
+def scene_names() -> list[str]:
+    """The registered scenes."""
+    from afford.sim.registry import scene_names as names
+
+    return names()
+
+
+def make_scene(name: str, **options):
+    """The scene ``name`` configured with ``options`` (``grid=30``, ``size_max=0.2``, ...)."""
+    from afford.sim.registry import make_scene as make
+
+    return make(name, **options)
+
+
+def explore(scene, *, episodes: int | None = None, interactions: int | None = None, seed: int = 0,
+            workers: int = 1, max_steps: int | None = None,
+            progress: Callable[[int, int], None] | None = None, **options):
+    """Explore a scene (a name, with its ``options``, or a scene object) with its own loop
+    (Algorithm 5 or 1): the :class:`Interactions` recorded. Give ``episodes`` (100 when
+    neither is given) or ``interactions``; the same seed gives the same rows for any number
+    of workers. ``progress(done, total)`` is called as work finishes."""
+    from afford.sim.explore import explore as run
+
+    sc = make_scene(scene, **options) if isinstance(scene, str) else scene
+    if episodes is None and interactions is None:
+        episodes = 100
+    data = run(sc, episodes=episodes, interactions=interactions, seed=seed, workers=workers,
+               max_steps=max_steps, progress=progress)
+    if len(data) == 0:
+        raise AffordError("exploration recorded no interactions (no object was ever seen)")
+    return data
+
+
+def world(scene="table", *, seed: int | None = 0, layout=None, **drawn):
+    """A simulated world to perceive and act in (``perceive()``, ``act(behaviour, target)``).
+
+    ``layout`` is a layout file's path or a layout the scene parsed; without one the
+    layout is drawn from ``seed`` (and ``drawn`` options such as ``objects=3``), the same
+    one ``afford plan --seed`` draws."""
+    from afford.sim.scene import check_options, load_layout_file
+    from afford.sim.session import SimWorld
+
+    sc = make_scene(scene) if isinstance(scene, str) else scene
+    given = {k: v for k, v in drawn.items() if v not in (None, False)}
+    check_options(sc, given)
+    if layout is None:
+        if seed is None:
+            raise AffordError("give a layout, or a seed to draw a random one")
+        specs = sc.sample(_layout_rng(seed), **given)
+    elif isinstance(layout, str) or hasattr(layout, "__fspath__"):
+        specs = load_layout_file(sc, layout)
+    else:
+        specs = layout
+    sc.check_layout(specs)
+    return SimWorld(sc, specs, seed or 0)
+
+
+def _layout_rng(seed: int) -> np.random.Generator:
+    """The stream random layouts are drawn from (``--seed`` of plan, emulate and predict)."""
+    return np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(7,)))
+
+
+def parse_goal(goal, schema):
+    """A goal from ``"0:x>0.15"``-style expressions (one string, a list, or a Goal)."""
+    from afford.plan.goals import Goal, GoalError, parse_goal as parse
+
+    if isinstance(goal, Goal):
+        return goal
+    try:
+        return parse([goal] if isinstance(goal, str) else list(goal), schema)
+    except GoalError as exc:
+        raise AffordError(str(exc)) from None
+
+
+class Model(LoadedModel):
+    """A learned model: per behaviour the chosen features, a calibrated predictor and, where
+    categories were discovered, the effect prototypes the planner chains.
+
+    Attributes: ``names`` (behaviours), ``schema`` (its ``names`` are the feature names),
+    ``label_source`` (``discovered`` or ``given``), ``result_names``, ``selected``.
+    """
+
+    def forward(self, min_probability: float = 0.02):
+        """The planner's forward model (outcomes below ``min_probability`` are dropped)."""
+        cache = self.__dict__.setdefault("_forward", {})
+        if min_probability not in cache:
+            from afford.learning import forward_model
+
+            cache[min_probability] = forward_model(self, min_probability=min_probability)
+        return cache[min_probability]
+
+    def _rows(self, X) -> np.ndarray:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        if X.ndim != 2 or X.shape[1] != len(self.schema):
+            raise AffordError(f"give feature vectors of {len(self.schema)} features (the model's schema), "
+                              f"got an array of shape {np.shape(X)}")
+        if not np.all(np.isfinite(X)):
+            raise AffordError("feature vectors must be finite numbers")
+        return X
+
+    def predict_proba(self, behavior: str, X, alpha: Sequence[float] = ()) -> tuple[np.ndarray, np.ndarray]:
+        """(categories, probabilities): for each row of ``X`` (full feature vectors), the
+        calibrated probability of each category, times P(known) where the model has one, so
+        a row may sum below 1 (the rest is an effect of a kind too rare to keep); the same
+        numbers ``afford predict`` and the planner use. ``alpha``: the behaviour's parameters."""
+        fm = self.forward(min_probability=0.0)
+        b = fm.index(behavior)
+        alpha = tuple(float(a) for a in alpha)
+        if len(alpha) != len(fm.behaviors[b].parameters):
+            raise AffordError(f"{behavior} takes {len(fm.behaviors[b].parameters)} parameters, got {len(alpha)}")
+        rows = self._rows(X)
+        fm.prefetch(list(rows), only=b, alpha_only=alpha)
+        out = [fm.distribution(f, b, alpha) for f in rows]
+        classes = out[0][0] if out else np.asarray(self.predictors[behavior].classes_, dtype=int)
+        return classes, np.stack([p for _, p in out]) if out else np.zeros((0, classes.size))
+
+    def predict(self, behavior: str, X, alpha: Sequence[float] = ()) -> np.ndarray:
+        """The most probable category (or given result's index) for each row of ``X``."""
+        classes, p = self.predict_proba(behavior, X, alpha)
+        return classes[np.argmax(p, axis=1)] if len(p) else np.zeros(0, dtype=int)
+
+    def predictions(self, state: np.ndarray) -> list[dict]:
+        """For each entity of a perceived ``state`` and each behaviour: the probabilities and,
+        where effects are predicted, the most probable category's next entity (what
+        ``afford predict`` reports)."""
+        from afford.plan.forward import SCENE
+
+        fm = self.forward(min_probability=0.0)
+        state = np.asarray(state, dtype=float)
+        schema = self.schema
+        out = []
+        for i, f in enumerate(state):
+            seen = bool(schema.visible(f))
+            entry = {"object": i, "visible": seen, "features": _named(schema, f), "behaviors": {}}
+            if seen:
+                for b, name in enumerate(self.names):
+                    classes, proba = fm.distribution(f, b, ())
+                    best = int(classes[np.argmax(proba)])
+                    p = {"category": best, "probability": round(float(proba.max()), 4),
+                         "probabilities": {str(int(c)): round(float(q), 4) for c, q in zip(classes, proba)},
+                         # an effect of a kind the model discarded as rare (P(known) < 1), which no plan counts on
+                         "unknown": round(max(0.0, 1.0 - float(proba.sum())), 4)}
+                    if self.label_source == "given":
+                        p["result"] = self.result_names[best]
+                    else:
+                        obj = SCENE if fm.behaviors[b].target is None else i
+                        cats = [best if j == i else None for j in range(state.shape[0])] if obj == SCENE else best
+                        nxt = fm.apply(state, obj, b, cats)[i]
+                        p["next"] = {"visible": bool(schema.visible(nxt)), "features": _named(schema, nxt)}
+                    entry["behaviors"][name] = p
+            out.append(entry)
+        return out
+
+    def plans(self, state: np.ndarray, goal, *, alternatives: int = 3, max_replans: int = 3,
+              method: str = "best-first", max_depth: int = 5, max_nodes: int = 20000):
+        """Candidate plans from a perceived ``state`` to ``goal``, ranked by their probability
+        of reaching it with monitoring and up to ``max_replans`` replans, best first."""
+        from afford.plan.monitor import rank_plans
+
+        self.check_effects("planning")
+        goal = parse_goal(goal, self.schema)
+        state = np.asarray(state, dtype=float)
+        goal.check_objects(state.shape[0])
+        return rank_plans(self.forward(), state, goal, alternatives, max_replans=max_replans, method=method,
+                          max_depth=max_depth, max_nodes=max_nodes)
+
+    def plan(self, state: np.ndarray, goal, **limits):
+        """The best of :meth:`plans` (``plan.found``, ``plan.steps``, ``plan.success_probability``)."""
+        return self.plans(state, goal, **limits)[0]
+
+    def execute(self, world, goal, *, first=None, alternatives: int = 3, max_replans: int = 3,
+                method: str = "best-first", max_depth: int = 5, max_nodes: int = 20000):
+        """Plan in ``world`` (see :func:`world`; ``first``: a plan already made there), act,
+        compare each step with its prediction, and replan on a surprise (each replan chosen
+        among ``alternatives`` the same way): the :class:`afford.plan.monitor.Execution`."""
+        from afford.plan.monitor import execute as run
+        from afford.plan.monitor import ranked_planner
+
+        self.check_schema(world.scene.schema, "this scene's perception")
+        limits = {"max_depth": max_depth, "max_nodes": max_nodes}
+        if first is None:
+            first = self.plan(world.perceive(), goal, alternatives=alternatives, max_replans=max_replans,
+                              method=method, **limits)
+        goal = parse_goal(goal, self.schema)
+        planner = ranked_planner(self.forward(), goal, alternatives, max_replans=max_replans, method=method, **limits)
+        return run(world, self.forward(), goal, method=method, max_replans=max_replans, first=first,
+                   planner=planner, **limits)
+
+    def inverse(self, state: np.ndarray, want) -> list[dict]:
+        """Inverse query: (object, behaviour, alpha) ranked by the probability that one step
+        makes ``want`` hold."""
+        from afford.plan.search import inverse_query
+
+        self.check_effects("an inverse query")
+        goal = parse_goal(want, self.schema)
+        state = np.asarray(state, dtype=float)
+        goal.check_objects(state.shape[0])
+        return inverse_query(self.forward(min_probability=0.0), state, goal)
+
+
+#: Geometry features shown per entity, at most (an environment of 3900 features shows none).
+_SHOWN = 12
+
+
+def _named(schema, f: np.ndarray) -> dict:
+    cols = schema.geometry
+    if cols.size > _SHOWN:
+        return {}
+    return {schema.names[i]: round(float(f[i]), 4) for i in cols}

@@ -1,0 +1,105 @@
+"""The Python API: the README's example runs as written, and the API is the CLI's own code."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import afford
+from afford.app import app
+from afford.artifacts import read_artifact
+from afford.features import Interactions
+
+ROOT = Path(__file__).resolve().parents[1]
+runner = CliRunner()
+
+
+def _readme_example() -> str:
+    text = (ROOT / "README.md").read_text()
+    match = re.search(r"<!-- api-example -->\n```python\n(.*?)```", text, re.S)
+    assert match, "README.md lost its <!-- api-example --> block"
+    return match.group(1)
+
+
+def test_the_readme_example_runs_as_written(pipeline, tmp_path):
+    for name in ("train.afford", "effects.afford", "model.afford"):
+        shutil.copy(pipeline / name, tmp_path / name)
+    script = tmp_path / "example.py"
+    script.write_text(_readme_example())
+    proc = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True,
+                          env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    lines = proc.stdout.splitlines()
+    assert lines[0].startswith("480 interactions, 43 features")
+    assert re.match(r"(reached|not reached) after \d+ replans", lines[-1])
+    # what the example saved is an interactions file the CLI reads, of the seed it was given
+    info = json.loads(runner.invoke(app, ["inspect", str(tmp_path / "more.afford"), "--json"]).stdout)
+    assert info["kind"] == "interactions" and info["seed"] == 7
+
+
+def test_load_returns_what_each_file_holds(pipeline):
+    data = afford.load(str(pipeline / "train.afford"))
+    assert isinstance(data, Interactions) and isinstance(afford.load(str(pipeline / "effects.afford")), Interactions)
+    assert len(data) == 480 and data.before.shape == (480, len(data.schema.names))
+    model = afford.load(str(pipeline / "model.afford"))
+    assert isinstance(model, afford.Model) and model.names == data.behavior_names
+    labels = afford.load_labels(str(pipeline / "effects.afford"))
+    assert np.array_equal(labels, read_artifact(str(pipeline / "effects.afford")).arrays["category"])
+    with pytest.raises(afford.AffordError, match="holds no labels"):
+        afford.load_labels(str(pipeline / "train.afford"))  # discovered labels need `cluster` first
+
+
+def test_predict_proba_is_what_afford_predict_reports(pipeline):
+    model = afford.load_model(str(pipeline / "model.afford"))
+    world = afford.world("table", seed=2, objects=2)
+    state = world.perceive()
+    out = json.loads(runner.invoke(app, ["predict", str(pipeline / "model.afford"), "--seed", "2", "--objects", "2",
+                                         "--json"]).stdout)
+    for entry in out["objects"]:
+        for name, p in entry["behaviors"].items():
+            classes, proba = model.predict_proba(name, state[entry["object"]])
+            assert {str(c): round(float(q), 4) for c, q in zip(classes, proba[0])} == p["probabilities"]
+            assert int(model.predict(name, state[entry["object"]])[0]) == p["category"]
+
+
+def test_a_feature_vector_of_the_wrong_length_is_one_sentence(pipeline):
+    model = afford.load_model(str(pipeline / "model.afford"))
+    with pytest.raises(afford.AffordError, match="give feature vectors of 43 features"):
+        model.predict_proba("push-forward", np.zeros((2, 40)))
+    with pytest.raises(afford.features.errors.DataError, match="unknown behaviour 'jump'"):
+        model.predict_proba("jump", np.zeros((1, 43)))
+    with pytest.raises(afford.AffordError, match="finite"):
+        model.predict_proba("lift", np.full((1, 43), np.nan))
+
+
+def test_api_exploration_is_the_cli_exploration(tmp_path):
+    runner.invoke(app, ["explore", "--episodes", "3", "--seed", "11", "-o", str(tmp_path / "cli.afford")])
+    afford.save(afford.explore("table", episodes=3, seed=11, workers=2), str(tmp_path / "api.afford"), seed=11)
+    cli, api = (read_artifact(str(tmp_path / f"{n}.afford")) for n in ("cli", "api"))
+    assert cli.manifest["members"] == api.manifest["members"]  # every array, byte for byte
+
+
+def test_the_plan_the_api_makes_is_the_plan_the_cli_makes(pipeline):
+    model = afford.load_model(str(pipeline / "model.afford"))
+    plan = model.plan(afford.world("table", seed=4, objects=1).perceive(), "*:visibility=0")
+    out = json.loads(runner.invoke(app, ["plan", str(pipeline / "model.afford"), "--seed", "4", "--objects", "1",
+                                         "--goal", "*:visibility=0", "--json"]).stdout)
+    assert plan.to_json()["steps"] == out["plan"]["steps"]
+    assert round(plan.success_probability, 4) == out["plan"]["success_probability"]
+
+
+def test_version_and_light_import():
+    proc = subprocess.run([sys.executable, "-m", "afford", "--version"], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stdout.strip() == f"afford {afford.__version__}"
+    assert re.fullmatch(r"\d+\.\d+\.\d+.*", afford.__version__)
+    code = "import sys, afford.features; sys.exit(int('sapien' in sys.modules or 'afford.api' in sys.modules))"
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
