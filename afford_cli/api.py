@@ -32,7 +32,7 @@ from afford.artifacts import read_artifact
 
 __all__ = [
     "AffordError", "load", "load_interactions", "load_labels", "load_model", "save", "Model",
-    "scene_names", "make_scene", "explore", "world", "parse_goal",
+    "scene_names", "make_scene", "explore", "world", "parse_goal", "to_frame",
 ]
 
 
@@ -57,6 +57,15 @@ def load_labels(path: str) -> np.ndarray:
     robot's own result where the labels were given (chapters 5-6)."""
     art, data = read_rows(path)
     return read_effects(art, data)[0]
+
+
+def to_frame(source):
+    """A pandas DataFrame of interactions (an artefact's path, or :class:`Interactions`): one
+    row per interaction, the features by name (columns in :mod:`afford.export`). Needs the
+    ``export`` extra (pandas)."""
+    from afford.export import frame_of, to_frame as frame
+
+    return frame(source) if isinstance(source, str) else frame_of(source)
 
 
 def load_model(path: str) -> "Model":
