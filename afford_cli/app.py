@@ -14,7 +14,7 @@ from typing import Annotated, Callable
 import typer
 
 from afford.commands import (
-    cluster, demo, emulate, evaluate, explore, export, inspect, plan, predict, scenes, select_features, train,
+    cluster, demo, emulate, evaluate, explore, export, inspect, pddl, plan, predict, scenes, select_features, train,
 )
 from afford.errors import AffordError
 from afford.features.errors import DataError
@@ -66,7 +66,7 @@ def _guarded(command: Callable) -> Callable:
 for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore), ("cluster", cluster.cluster),
                         ("select-features", select_features.select_features), ("train", train.train),
                         ("evaluate", evaluate.evaluate), ("predict", predict.predict),
-                        ("plan", plan.plan), ("emulate", emulate.emulate),
+                        ("plan", plan.plan), ("emulate", emulate.emulate), ("pddl", pddl.pddl),
                         ("inspect", inspect.inspect), ("export", export.export), ("demo", demo.demo)):
     app.command(_name)(_guarded(_command))
 

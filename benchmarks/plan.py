@@ -8,6 +8,12 @@ apart). Each scene draws three objects within reach and asks for all three to be
 Search time is reported apart from the time to estimate the plan's success probability
 with monitoring (``plan.monitor.assess``, which ``afford plan`` adds), and from the time to
 rank the three most probable plans by that probability (``--alternatives 3``).
+
+Beside it, on the same goals: the task as PDDL (``afford.plan.pddl``) solved by Fast
+Downward (A* with LM-cut, extra ``afford[pddl]``): the time to write the PDDL, the planner's
+time and its plan length. Both plans are then executed in the simulator: Fast Downward's
+blind, afford's as ``afford plan --alternatives 1 --max-replans 0 --execute`` runs it (which
+stops at the first surprise) and blind.
 Prints one JSON object and writes it to ``--out``.
 """
 
@@ -60,6 +66,14 @@ def main() -> None:
     from afford.plan.monitor import assess, rank_plans
     from afford.plan.search import best_first
 
+    try:
+        from afford.plan.pddl import build_task
+        from afford.solvers import check_solver, run_blind, solve_pddl
+
+        check_solver()
+        pddl = True
+    except Exception:  # the extra is not installed: no comparison
+        pddl = False
     model = load_model(model_path)
     goals = {
         "all three gone": ["0:visibility=0", "1:visibility=0", "2:visibility=0"],
@@ -82,9 +96,24 @@ def main() -> None:
             assess_s = time.perf_counter() - t0
             t0 = time.perf_counter()
             rank_plans(forward_model(model), state, goal, 3, max_depth=5, max_nodes=20000)  # --alternatives 3
-            rows.append({"goal": name, "found": plan.found, "length": len(plan.steps), "seconds": plan.seconds,
-                         "assess_seconds": assess_s, "rank3_seconds": time.perf_counter() - t0,
-                         "expanded": plan.expanded, "generated": plan.generated, "predictions": fm.predictions})
+            row = {"goal": name, "found": plan.found, "length": len(plan.steps), "seconds": plan.seconds,
+                   "assess_seconds": assess_s, "rank3_seconds": time.perf_counter() - t0,
+                   "expanded": plan.expanded, "generated": plan.generated, "predictions": fm.predictions}
+            if pddl:
+                t0 = time.perf_counter()
+                task = build_task(forward_model(model), state, goal, max_depth=5)
+                row["pddl_write_seconds"] = time.perf_counter() - t0
+                fd = solve_pddl(task)
+                row.update(fd_found=fd["solved"], fd_length=len(fd["steps"]), fd_seconds=fd["seconds"],
+                           situations=len(task.situations))
+                row["fd_reached"] = fd["solved"] and run_blind(open_world(scene, specs, args.seed + s), goal,
+                                                               fd["steps"])["reached"]
+                one = model.plans(state, goal, alternatives=1, max_replans=0)[0]
+                row["afford_reached"] = one.found and model.execute(
+                    open_world(scene, specs, args.seed + s), goal, first=one, alternatives=1, max_replans=0).reached
+                row["afford_blind_reached"] = one.found and run_blind(
+                    open_world(scene, specs, args.seed + s), goal, [(p.behavior, p.obj) for p in one.steps])["reached"]
+            rows.append(row)
     secs = np.array([r["seconds"] for r in rows])
     nodes = np.array([r["expanded"] for r in rows])
     result = {
@@ -105,6 +134,23 @@ def main() -> None:
                         "mean_seconds": round(float(np.mean([r["seconds"] for r in rows if r["goal"] == g])), 4)}
                     for g in goals},
     }
+    if pddl:
+        def stat(key, g=None):
+            vals = [r[key] for r in rows if g is None or r["goal"] == g]
+            return {"mean": round(float(np.mean(vals)), 4), "max": round(float(np.max(vals)), 4)}
+
+        result["fast_downward"] = {
+            "write_pddl_seconds": stat("pddl_write_seconds"), "solve_seconds": stat("fd_seconds"),
+            "situations": stat("situations"),
+            "by_goal": {g: {"found": sum(r["fd_found"] for r in rows if r["goal"] == g),
+                            "mean_length": round(float(np.mean([r["fd_length"] for r in rows
+                                                                if r["goal"] == g and r["fd_found"]] or [0])), 2),
+                            "reached_in_simulation": sum(bool(r["fd_reached"]) for r in rows if r["goal"] == g),
+                            "afford_reached_in_simulation": sum(bool(r["afford_reached"]) for r in rows if r["goal"] == g),
+                            "afford_blind_reached_in_simulation": sum(bool(r["afford_blind_reached"]) for r in rows
+                                                                      if r["goal"] == g)}
+                        for g in goals},
+        }
     emit(result, args.out)
 
 
