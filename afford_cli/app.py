@@ -59,6 +59,9 @@ def _guarded(command: Callable) -> Callable:
             message = str(exc)
             sys.stderr.write(f"error: {message}\n")
             raise typer.Exit(1) from None
+        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: outputs are written whole or not at all
+            sys.stderr.write("\nerror: interrupted; the output being written was discarded\n")
+            raise typer.Exit(130) from None
 
     return run
 
@@ -71,8 +74,15 @@ for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
     app.command(_name)(_guarded(_command))
 
 
+def _terminate(signum, frame):  # noqa: ARG001
+    raise KeyboardInterrupt  # SIGTERM is an interruption like Ctrl-C: temp files go, exit 130
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console entry point."""
+    import signal
+
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         app(args=argv)
     except KeyboardInterrupt:

@@ -22,6 +22,8 @@ import hashlib
 import io
 import json
 import os
+import re
+import stat
 import sys
 import tempfile
 import zipfile
@@ -35,7 +37,7 @@ from afford.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
-    "artifact_bytes", "dump_estimator", "load_estimator", "check_output",
+    "artifact_bytes", "dump_estimator", "load_estimator", "check_output", "writes_stdout",
 ]
 
 FORMAT = "afford"
@@ -54,6 +56,15 @@ def _version() -> str:
     from afford import __version__
 
     return __version__
+
+
+def _created() -> str:
+    """The write time, UTC to the second; ``SOURCE_DATE_EPOCH`` (the reproducible-builds
+    convention) fixes it, so that two runs can give byte-identical files."""
+    epoch = os.environ.get("SOURCE_DATE_EPOCH")
+    when = (_dt.datetime.fromtimestamp(int(epoch), _dt.timezone.utc) if epoch and epoch.isdigit()
+            else _dt.datetime.now(_dt.timezone.utc))
+    return when.strftime("%Y-%m-%dT%H:%M:%SZ")
 
 
 def _sha256(data: bytes) -> str:
@@ -125,9 +136,58 @@ def _rename_modules(blob: bytes, where: str) -> bytes:
 
 
 def dump_estimator(estimator) -> bytes:
+    """skops bytes of ``estimator``, canonical: the same estimator gives the same bytes."""
     import skops.io as sio
 
-    return sio.dumps(estimator)
+    return _canonical_skops(sio.dumps(estimator))
+
+
+def _canonical_skops(blob: bytes) -> bytes:
+    """skops names each object (``__id__``) and each array member (``<id>.npy``) by its
+    Python ``id()`` and stamps the zip entries with the wall clock, so equal estimators gave
+    other bytes every run. Here ids become their order of first appearance, array members
+    follow them, and entries carry a fixed time, in name order: equal estimators, equal bytes."""
+    with zipfile.ZipFile(io.BytesIO(blob)) as zin:
+        members = {info.filename: zin.read(info.filename) for info in zin.infolist()}
+    schema = json.loads(members.pop("schema.json"))
+    ids: dict[int, int] = {}
+
+    def walk(node):
+        if isinstance(node, dict):
+            out = {}
+            for k, v in node.items():
+                if k == "__id__" and isinstance(v, int):
+                    out[k] = ids.setdefault(v, len(ids))
+                else:
+                    out[k] = walk(v)
+            return out
+        if isinstance(node, list):
+            return [walk(v) for v in node]
+        return node
+
+    schema = walk(schema)
+    files: dict[str, str] = {}
+
+    def rename(node):
+        if isinstance(node, dict):
+            return {k: (files.setdefault(v, f"a{len(files)}.npy") if k == "file" and isinstance(v, str) and v in members
+                        else rename(v))
+                    for k, v in node.items()}
+        if isinstance(node, list):
+            return [rename(v) for v in node]
+        return node
+
+    schema = rename(schema)
+    out = {"schema.json": json.dumps(schema, indent=2, sort_keys=False).encode()}
+    out.update({new: members[old] for old, new in files.items()})
+    out.update({k: v for k, v in members.items() if k not in files})  # any member no node names
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_STORED) as zout:
+        for name in sorted(out):
+            info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
+            info.external_attr = 0o644 << 16
+            zout.writestr(info, out[name])
+    return buf.getvalue()
 
 
 def load_estimator(blob: bytes, where: str, trusted: list[str]):
@@ -170,7 +230,7 @@ def artifact_bytes(kind: str, arrays: dict[str, np.ndarray], meta: dict[str, Any
         "kind": kind,
         "schema_version": SCHEMA_VERSION,
         "afford_version": _version(),
-        "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "created": _created(),
         "command": list(sys.argv if command is None else command),
         "seed": seed,
         "parents": list(parents or []),
@@ -188,43 +248,101 @@ def artifact_bytes(kind: str, arrays: dict[str, np.ndarray], meta: dict[str, Any
     return buf.getvalue()
 
 
-def check_output(path: str) -> None:
-    """Fail before any work if ``path`` cannot take an artefact (``-`` always can)."""
+def _target(path: str) -> tuple[str, Path]:
+    """Where output ``path`` goes, decided before any work (DESIGN.md section 3):
+
+    * ``("stream", p)``: a character device, FIFO or socket (``/dev/null``, ``/dev/stdout``
+      onto a pipe, ``/dev/fd/N`` from a shell's ``>(cmd)``): written in order, never replaced;
+    * ``("file", p)``: a regular file, or none yet: written beside itself and renamed into
+      place, atomically. A symlink is followed: its target is written, the link stays.
+
+    A name ending in ``/``, a directory, a missing parent and a place that takes no new file
+    are refused in one sentence naming the target.
+    """
+    if not path:
+        raise AffordError("give a file name for the output (-o FILE, or -o - for stdout)")
+    if path.endswith("/") or path.endswith(os.sep):
+        raise AffordError(f"{path} ends in '/': give a file name, not a directory")
+    p = Path(path)
+    if p.is_dir():
+        raise AffordError(f"{path} is a directory; give a file name")
+    try:
+        mode = os.stat(p).st_mode  # follows symlinks
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise AffordError(f"cannot write {path}: {exc.strerror.lower() if exc.strerror else exc}") from None
+    if mode is not None and (not stat.S_ISREG(mode) or _is_fd_path(p)):
+        if not os.access(p, os.W_OK):
+            raise AffordError(f"cannot write {path}: permission denied")
+        return "stream", p
+    real = Path(os.path.realpath(p))  # a link's target; a dangling link's would-be target
+    parent = real.parent
+    if not parent.is_dir():
+        raise AffordError(f"cannot write {path}: the directory {parent} does not exist")
+    if mode is not None and not os.access(real, os.W_OK):
+        raise AffordError(f"cannot write {path}: permission denied")
+    try:  # the only sure test of "can a new file go here" (/proc, /sys and read-only mounts say yes to access())
+        fd, probe = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".probe", dir=parent)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        reason = exc.strerror.lower() if exc.strerror else "it takes no new file"
+        raise AffordError(f"cannot write {path}: {parent} refuses new files ({reason})") from None
+    return "file", real
+
+
+def _is_fd_path(p: Path) -> bool:
+    """``/dev/stdout``, ``/dev/fd/N``, ``/proc/self/fd/N``: an open descriptor, written in
+    place even when it is a regular file (a shell's ``> file``), never renamed over."""
+    text = os.path.abspath(p)
+    return text in ("/dev/stdout", "/dev/stderr") or bool(re.match(r"^/(dev/fd|proc/(self|\d+)/fd)/\d+$", text))
+
+
+def writes_stdout(path: str) -> bool:
+    """Does output ``path`` land on this process's standard output (``-``, ``/dev/stdout``,
+    a pipe or file stdout also holds)? Then the report goes to stderr."""
     if path == "-":
+        return True
+    try:
+        here, there = os.fstat(sys.stdout.fileno()), os.stat(path)
+    except (OSError, ValueError, AttributeError):
+        return False
+    return (here.st_dev, here.st_ino) == (there.st_dev, there.st_ino)
+
+
+def check_output(path: str) -> None:
+    """Fail before any work if ``path`` cannot take the output (``-`` always can, unless it
+    is a terminal and the output is an artefact)."""
+    if path == "-" or writes_stdout(path):
         if sys.stdout.isatty():
             raise AffordError("refusing to write an artefact to the terminal; give -o FILE or pipe it on")
-        return
-    if not path:
-        raise AffordError("give a file name for the artefact (-o FILE, or -o - for stdout)")
-    target = Path(path)
-    if target.is_dir():
-        raise AffordError(f"{path} is a directory; give a file name for the artefact")
-    parent = target.parent if str(target.parent) else Path(".")
-    if not parent.is_dir():
-        what = "is not a directory" if parent.exists() else "does not exist"
-        raise AffordError(f"cannot write {path}: {parent} {what}")
-    if not os.access(parent, os.W_OK):
-        raise AffordError(f"cannot write {path}: the directory {parent} is not writable")
+        if path == "-":
+            return
+    _target(path)
 
 
 def write_artifact(path: str, data: bytes) -> None:
-    """Write artefact bytes to ``path`` atomically, or to stdout for ``-``."""
+    """Write ``data`` to ``path`` (see :func:`_target`): stdout for ``-``, streamed to a device
+    or pipe, else atomically (a temporary file beside the target, renamed into place)."""
     if path == "-":
         out = sys.stdout.buffer
         out.write(data)
         out.flush()
         return
-    target = Path(path)
-    if target.is_dir():
-        raise AffordError(f"{path} is a directory; give a file name for the artefact")
-    parent = target.parent if str(target.parent) else Path(".")
-    if not parent.exists():
-        raise AffordError(f"cannot write {path}: the directory {parent} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
+    kind, target = _target(path)
+    if kind == "stream":
+        try:
+            with open(target, "wb", buffering=0) as fh:
+                fh.write(data)
+        except OSError as exc:
+            raise AffordError(f"cannot write {path}: {exc.strerror.lower() if exc.strerror else exc}") from None
+        return
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     umask = os.umask(0)
     os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a saved artefact gets the usual mode
     try:
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a saved artefact gets the usual mode
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()

@@ -19,6 +19,10 @@ rows are the same whatever the number of workers and whichever worker ran the ep
 
 from __future__ import annotations
 
+import os
+import signal
+import sys
+
 from dataclasses import dataclass
 from typing import Callable, Iterator
 
@@ -207,7 +211,30 @@ def run_scan_episode(scene, seed: int, episode: int) -> Interactions:
     )
 
 
-def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int | None) -> list[Interactions]:
+def die_with_parent() -> None:
+    """In a worker process: ask Linux to kill it when its parent dies (``PR_SET_PDEATHSIG``),
+    so that a ``kill -9`` of afford leaves no idle workers behind (elsewhere: nothing)."""
+    global _ASKED
+    if _ASKED or not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # pragma: no cover - no prctl: nothing to ask
+        return
+    _ASKED = True
+    if os.getppid() == 1:  # the parent died before we asked
+        os._exit(1)
+
+
+_ASKED = False
+
+
+def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int | None, in_worker: bool = False) -> list[Interactions]:
+    if in_worker:
+        die_with_parent()
     return [run_episode(scene, seed, e, max_steps) for e in episodes]
 
 
@@ -257,7 +284,7 @@ def explore(
                 rate = total_rows / next_episode if next_episode else first_guess
                 need = max(workers * chunk, int((interactions - total_rows) / max(rate, 1.0)) + 1)
                 stop = next_episode + need
-            jobs = (delayed(_run_chunk)(scene, seed, eps, max_steps) for eps in _chunks(next_episode, stop, chunk))
+            jobs = (delayed(_run_chunk)(scene, seed, eps, max_steps, workers > 1) for eps in _chunks(next_episode, stop, chunk))
             for result in parallel(jobs):
                 parts.extend(result)
                 total_rows += sum(len(r) for r in result)

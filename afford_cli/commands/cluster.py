@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.artifacts import artifact_bytes, check_output, write_artifact, writes_stdout
 from afford.errors import AffordError
 from afford.learning import effects_members, read_rows
 from afford.options import InputPath, Json, OutputPath, Seed
@@ -42,7 +42,7 @@ def cluster(
     if k is not None and method is not Method.kmeans:
         raise typer.BadParameter("--k goes with --method kmeans")
     check_output(output)
-    out = Output(json, stdout_busy=output == "-")
+    out = Output(json, stdout_busy=writes_stdout(output))
     art, data = read_rows(path)
     if not data.has_after:
         raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "

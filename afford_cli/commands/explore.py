@@ -6,7 +6,7 @@ import time
 from typing import Annotated, Optional
 
 import typer
-from afford.artifacts import check_output
+from afford.artifacts import check_output, writes_stdout
 from afford.datasets import behaviour_counts, outcome_table, result_rates
 from afford.reports import render_outcome_table, render_result_rates
 from afford.scenes_io import make_scene
@@ -82,7 +82,7 @@ def explore(
     if size_min is not None and size_max is not None and size_min > size_max:
         raise typer.BadParameter(f"--size-min ({size_min}) is larger than --size-max ({size_max})")
     check_output(output)
-    out = Output(json, stdout_busy=output == "-")
+    out = Output(json, stdout_busy=writes_stdout(output))
     sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps, grid=grid, layers=layers)
     data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
                           workers=workers)

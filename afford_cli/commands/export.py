@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from afford.artifacts import check_output, write_artifact
+from afford.artifacts import check_output, write_artifact, writes_stdout
 from afford.options import InputPath, Json
 from afford.output import Output
 
@@ -27,6 +27,6 @@ def export(
     frame = to_frame(path)
     write_artifact(output, export_bytes(frame, fmt))
     result = {"output": output, "format": fmt, "rows": int(frame.shape[0]), "columns": int(frame.shape[1])}
-    Output(json, stdout_busy=output == "-").result(
+    Output(json, stdout_busy=writes_stdout(output)).result(
         result, lambda console: console.print(f"exported {result['rows']} rows x {result['columns']} columns "
                                               f"({fmt}) -> {output}"))

@@ -9,7 +9,7 @@ from typing import Annotated, Optional
 import typer
 from rich.table import Table
 
-from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.artifacts import artifact_bytes, check_output, write_artifact, writes_stdout
 from afford.learning import features_members, learner_settings, read_effects, read_rows
 from afford.options import InputPath, Json, KernelOption, OutputPath, Seed
 from afford.output import Output
@@ -35,7 +35,7 @@ def select_features(
     from afford.learn.affordances import rank_features
 
     check_output(output)
-    out = Output(json, stdout_busy=output == "-")
+    out = Output(json, stdout_busy=writes_stdout(output))
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
     kernel_name, _ = learner_settings(art, data, kernel.value if kernel is not None else None)

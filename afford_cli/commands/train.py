@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 import typer
 from rich.table import Table
 
-from afford.artifacts import artifact_bytes, check_output, write_artifact
+from afford.artifacts import artifact_bytes, check_output, write_artifact, writes_stdout
 from afford.learning import learner_settings, model_members, read_effects, read_rows, read_selection
 from afford.options import InputPath, Json, KernelOption, OutputPath, Seed
 from afford.output import Output
@@ -26,7 +26,7 @@ def train(
     from afford.learn.affordances import train_known, train_predictors
 
     check_output(output)
-    out = Output(json, stdout_busy=output == "-")
+    out = Output(json, stdout_busy=writes_stdout(output))
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, effects = read_effects(art, data)
     selected = read_selection(art, data)
