@@ -27,6 +27,7 @@ import stat
 import sys
 import tempfile
 import zipfile
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -87,18 +88,57 @@ class Artifact:
     blobs: dict[str, bytes] = field(default_factory=dict)   # raw .skops members
     sha256: str = ""
     source: str = ""
+    sealed: bool = True   # the manifest's own checksum was there and matched (schema 2 on)
+
+    def __post_init__(self):
+        self.arrays = _Members(self.arrays, self.source, ".npy")
+        self.blobs = _Members(self.blobs, self.source, ".skops")
 
     def parent_ref(self) -> dict[str, str]:
         return {"kind": self.kind, "sha256": self.sha256}
 
-    def estimator(self, name: str, trusted: list[str]):
-        """Load estimator member ``name`` with skops, refusing any type not trusted."""
+    def estimator(self, name: str, trusted: list[str], expect: type | None = None):
+        """Load estimator member ``name`` with skops, refusing any type not trusted, and one
+        that is not of type ``expect`` (a trusted type in the wrong slot is still wrong)."""
         if name not in self.blobs:
-            raise AffordError(f"{self.source} holds no estimator named {name!r}")
+            raise AffordError(f"{self.source} holds no estimator named {name!r}; it is corrupt or was edited")
         blob = self.blobs[name]
         if self.manifest.get("schema_version", SCHEMA_VERSION) < 3:
             blob = _rename_modules(blob, f"{self.source}: {name}")
-        return load_estimator(blob, f"{self.source}: {name}", trusted)
+        obj = load_estimator(blob, f"{self.source}: {name}", trusted)
+        if expect is not None and type(obj) is not expect:
+            raise AffordError(f"{self.source}: {name} holds {_a(type(obj).__name__)} where {_a(expect.__name__)} "
+                              "belongs; it was edited")
+        return obj
+
+
+@contextmanager
+def reading(art: "Artifact"):
+    """Reading an artefact's structure: a manifest or array that does not fit what its kind
+    holds (a forged file, with its checksums recomputed) is one sentence, not a traceback."""
+    try:
+        yield
+    except AffordError:
+        raise
+    except (TypeError, KeyError, IndexError, AttributeError, ValueError) as exc:
+        detail = str(exc) if isinstance(exc, ValueError) and str(exc) else type(exc).__name__
+        raise AffordError(f"{art.source} is corrupt or was edited: what it holds does not fit {_a(art.kind)} "
+                          f"artefact ({detail})") from None
+
+
+def _a(word: str) -> str:
+    return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
+
+
+class _Members(dict):
+    """An artefact's members: a missing one is one sentence naming the file and the member."""
+
+    def __init__(self, items, source: str, suffix: str):
+        super().__init__(items)
+        self.source, self.suffix = source, suffix
+
+    def __missing__(self, key):
+        raise AffordError(f"{self.source} lacks the member {key}{self.suffix}; it is corrupt or was edited")
 
 
 #: Packages that were top-level before schema 3 and now live under ``afford``.
@@ -385,8 +425,10 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
         zf = zipfile.ZipFile(io.BytesIO(raw))
         text = zf.read("manifest.json")
         manifest = json.loads(text)
-    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError):
+    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError, ValueError):
         raise AffordError(f"{name} is not an afford file") from None
+    except (NotImplementedError, OSError, EOFError, RuntimeError):  # unsupported compression, bad directory
+        raise AffordError(f"{name} is corrupt: its zip structure cannot be read") from None
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         raise AffordError(f"{name} is not an afford file")
     kind = manifest.get("kind")
@@ -404,10 +446,15 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
     if version >= 2:
         try:
             seal = zf.read(_SEAL).decode("ascii")
-        except (KeyError, zipfile.BadZipFile, OSError, EOFError, UnicodeDecodeError):
+        except (KeyError, zipfile.BadZipFile, OSError, EOFError, UnicodeDecodeError, NotImplementedError):
             raise AffordError(f"{name} is corrupt or was edited: its manifest checksum is missing") from None
         if seal != _sha256(text):
             raise AffordError(f"{name} is corrupt or was edited: manifest.json does not match its checksum")
+    else:
+        later = sorted(set(manifest) & _LATER_FIELDS)
+        if later or _SEAL in zf.namelist():
+            raise AffordError(f"{name} claims artefact schema 1 but carries what only later schemas write "
+                              f"({(later or [_SEAL])[0]}); it was edited")
     manifest = _migrate(manifest)
     if kinds is not None:
         wanted = (kinds,) if isinstance(kinds, str) else tuple(kinds)
@@ -425,19 +472,46 @@ def read_artifact(path: str, kinds: tuple[str, ...] | str | None = None, *, data
     for member, digest in sorted(members.items()):
         try:
             blob = zf.read(member)
-        except (zipfile.BadZipFile, OSError, EOFError):  # zlib errors surface as BadZipFile
+        except (zipfile.BadZipFile, OSError, EOFError, NotImplementedError):  # zlib errors: BadZipFile
             raise AffordError(f"{name} is corrupt: member {member} cannot be read") from None
         except Exception:
             raise AffordError(f"{name} is corrupt: member {member} cannot be read") from None
         if _sha256(blob) != digest:
             raise AffordError(f"{name} is corrupt or was edited: checksum mismatch in {member}")
         if member.endswith(".npy"):
-            try:
-                arrays[member[:-4]] = np.load(io.BytesIO(blob), allow_pickle=False)
-            except ValueError:
-                raise AffordError(f"{name} holds an array member {member} that needs pickle; refused") from None
+            arrays[member[:-4]] = _load_npy(blob, f"{name}: member {member}")
         elif member.endswith(".skops"):
             blobs[member[:-6]] = blob
         else:
             raise AffordError(f"{name} holds an unknown member {member}")
-    return Artifact(kind=kind, manifest=manifest, arrays=arrays, blobs=blobs, sha256=_sha256(raw), source=name)
+    return Artifact(kind=kind, manifest=manifest, arrays=arrays, blobs=blobs, sha256=_sha256(raw), source=name,
+                    sealed=version >= 2)
+
+
+#: Manifest fields that schema 1 files never had: a file claiming schema 1 with one of them
+#: was relabelled (to skip the manifest's own checksum).
+_LATER_FIELDS = {"label_source", "result_names", "n_entities"}
+
+
+def _load_npy(blob: bytes, where: str) -> np.ndarray:
+    """An npy member, its header checked before anything is allocated: a plain numeric or
+    boolean dtype, and no more elements than the member's bytes can hold."""
+    buf = io.BytesIO(blob)
+    try:
+        major, _ = np.lib.format.read_magic(buf)
+        read = np.lib.format.read_array_header_1_0 if major == 1 else np.lib.format.read_array_header_2_0
+        shape, _, dtype = read(buf)
+    except (ValueError, OSError, EOFError, TypeError, SyntaxError):
+        raise AffordError(f"{where} is not a readable array") from None
+    if dtype.hasobject:
+        raise AffordError(f"{where} is an array that needs pickle; refused")
+    if dtype.kind not in "biuf":
+        raise AffordError(f"{where} holds {dtype} values, not numbers; it was edited")
+    count = int(np.prod(shape, dtype=object))
+    if count * dtype.itemsize > len(blob) - buf.tell():
+        raise AffordError(f"{where} claims {count} values ({'x'.join(map(str, shape))}) but holds "
+                          f"{len(blob) - buf.tell()} bytes; it is corrupt or was edited")
+    try:
+        return np.load(io.BytesIO(blob), allow_pickle=False)
+    except (ValueError, OSError, EOFError):
+        raise AffordError(f"{where} is not a readable array") from None

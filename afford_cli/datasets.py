@@ -94,10 +94,25 @@ def interactions_from_artifact(art: Artifact) -> Interactions:
                                 before_index=a["before_index"], after_index=a.get("after_index"), **rows, **rest)
         else:  # written before entities were stored once: a before and an after per row
             data = Interactions.from_rows(schema, list(m["behaviors"]), a["before"], a["after"], **rows, **rest)
-    except (KeyError, TypeError, ValueError, AttributeError) as exc:
-        raise AffordError(f"{art.source} does not hold interaction rows ({exc})") from None
+    except (KeyError, TypeError, ValueError, AttributeError, IndexError) as exc:
+        raise AffordError(f"{art.source} does not hold interaction rows that fit together ({type(exc).__name__}: "
+                          f"{exc}); it is corrupt or was edited") from None
     try:
         data.validate()
     except ValueError as exc:
         raise AffordError(f"{art.source}: {exc}") from None
+    _check_counts(art, data)
     return data
+
+
+def _check_counts(art: Artifact, data: Interactions) -> None:
+    """The manifest's counts are the arrays' (an edited manifest, resealed, is caught here)."""
+    m = art.manifest
+    actual = {"n_interactions": len(data), "n_episodes": int(np.unique(data.episode).size),
+              "n_entities": int(data.entities.shape[0])}
+    for key, value in actual.items():
+        if key in m and m[key] != value:
+            raise AffordError(f"{art.source} is corrupt or was edited: its manifest says {key} {m[key]!r}, "
+                              f"its arrays hold {value}")
+    if "counts" in m and m["counts"] != behaviour_counts(data):
+        raise AffordError(f"{art.source} is corrupt or was edited: its manifest's behaviour counts are not its arrays'")

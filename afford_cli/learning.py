@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from afford.artifacts import Artifact, dump_estimator, read_artifact
+from afford.artifacts import Artifact, dump_estimator, read_artifact, reading
 from afford.datasets import interactions_from_artifact, interactions_members
 from afford.errors import AffordError
 from afford.features import OUTCOMES, FeatureSchema, Interactions
@@ -83,8 +83,16 @@ def read_effects(art: Artifact, data: Interactions) -> tuple[np.ndarray, dict | 
     own success readings (then there are no effect categories: ``None``).
     """
     if "category" in art.arrays and "effects" in art.manifest:
-        models = {name: art.estimator(_blob_name("effects", name), TRUSTED) for name in data.behavior_names}
-        return art.arrays["category"].astype(int), models
+        from afford.learn.effects import EffectCategories
+
+        with reading(art):
+            models = {name: art.estimator(_blob_name("effects", name), TRUSTED, EffectCategories)
+                      for name in data.behavior_names}
+            labels = art.arrays["category"].astype(int)
+            if labels.shape != (len(data),) or (labels.size and (labels.min() < -1 or labels.max() >= 10_000)):
+                raise AffordError(f"{art.source}: category does not give one category per interaction; "
+                                  "it is corrupt or was edited")
+        return labels, models
     if data.result is not None:
         return data.result.astype(int), None
     raise AffordError(f"{art.source} holds no labels: its effects have no categories yet (run 'afford cluster' "
@@ -107,7 +115,16 @@ def features_members(art: Artifact, data: Interactions, relevance: dict, setting
 def read_selection(art: Artifact, data: Interactions) -> dict[str, np.ndarray]:
     """Chosen feature indices per behaviour (all features for an effects artefact)."""
     if art.kind == "features":
-        return {name: art.arrays[f"selected.{name}"].astype(int) for name in data.behavior_names}
+        d = len(data.schema)
+        out = {}
+        with reading(art):
+            for name in data.behavior_names:
+                idx = art.arrays[f"selected.{name}"].astype(int)
+                if idx.ndim != 1 or (idx.size and (idx.min() < 0 or idx.max() >= d)):
+                    raise AffordError(f"{art.source}: selected.{name} names features outside the schema's {d}; "
+                                      "it is corrupt or was edited")
+                out[name] = idx
+        return out
     return {name: np.arange(len(data.schema)) for name in data.behavior_names}
 
 
@@ -175,9 +192,16 @@ def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects
 
 
 class LoadedModel:
-    """A model artefact with its estimators loaded (trusted types only)."""
+    """A model artefact with its estimators loaded (trusted types only, each of its slot's type)."""
 
     def __init__(self, art: Artifact):
+        with reading(art):
+            self._load(art)
+
+    def _load(self, art: Artifact) -> None:
+        from afford.learn import AffordancePredictor
+        from afford.learn.effects import EffectCategories
+
         m = art.manifest
         self.art = art
         self.schema = FeatureSchema.from_json(m["schema"])
@@ -188,13 +212,23 @@ class LoadedModel:
         self.selected = {n: art.arrays[f"selected.{n}"].astype(int) for n in self.names}
         given = self.label_source == "given"
         self.prototypes = {n: None if given else art.arrays[f"prototypes.{n}"] for n in self.names}
-        self.effects = {n: None if given else art.estimator(_blob_name("effects", n), TRUSTED) for n in self.names}
-        self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED) for n in self.names}
-        self.known = {n: art.estimator(_blob_name("known", n), TRUSTED) if _blob_name("known", n) in art.blobs else None
-                      for n in self.names}
+        self.effects = {n: None if given else art.estimator(_blob_name("effects", n), TRUSTED, EffectCategories)
+                        for n in self.names}
+        self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED, AffordancePredictor) for n in self.names}
+        self.known = {n: art.estimator(_blob_name("known", n), TRUSTED, AffordancePredictor)
+                      if _blob_name("known", n) in art.blobs else None for n in self.names}
         # the features P(known) reads (models from before they had their own: the selected)
         self.known_selected = {n: art.arrays[f"known_selected.{n}"].astype(int) if f"known_selected.{n}" in art.arrays
                                else self.selected[n] for n in self.names}
+        d = len(self.schema)
+        for n in self.names:
+            for what, idx in (("selected", self.selected[n]), ("known_selected", self.known_selected[n])):
+                if idx.ndim != 1 or (idx.size and (idx.min() < 0 or idx.max() >= d)):
+                    raise AffordError(f"{art.source}: {what}.{n} names features outside the schema's {d}; "
+                                      "it is corrupt or was edited")
+            if not given and (self.prototypes[n].ndim != 2 or self.prototypes[n].shape[1] != d):
+                raise AffordError(f"{art.source}: prototypes.{n} does not have the schema's {d} features; "
+                                  "it is corrupt or was edited")
 
     def parameters(self, name: str) -> list[dict]:
         return list(self.behaviors[self.names.index(name)].get("parameters", []))

@@ -171,3 +171,147 @@ def test_sigterm_is_an_interruption_and_leaves_no_temp_file(tmp_path):
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130 and b"error: interrupted; the output being written was discarded" in err and b"Traceback" not in err
     assert not list(tmp_path.iterdir())
+
+
+# -- forged artefacts: checksums and seal recomputed, as a forger who knows the format would --
+
+def forge(src: Path, dst: Path, members: dict | None = None, manifest=None, seal: bool = True) -> Path:
+    """A copy of ``src`` with ``members`` replaced (bytes) or removed (None), ``manifest(m)``
+    applied, every checksum recomputed and (``seal``) the manifest resealed."""
+    import io
+    import json
+    import zipfile
+
+    from afford.artifacts import _sha256
+
+    with zipfile.ZipFile(src) as zf:
+        items = {n: zf.read(n) for n in zf.namelist()}
+    m = json.loads(items.pop("manifest.json"))
+    items.pop("manifest.sha256", None)
+    for name, data in (members or {}).items():
+        if data is None:
+            items.pop(name, None)
+        else:
+            items[name] = data
+    m["members"] = {n: _sha256(d) for n, d in items.items()}
+    if manifest is not None:
+        manifest(m)
+    text = json.dumps(m).encode()
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        zf.writestr("manifest.json", text)
+        if seal:
+            zf.writestr("manifest.sha256", _sha256(text))
+        for n, d in items.items():
+            zf.writestr(n, d)
+    dst.write_bytes(buf.getvalue())
+    return dst
+
+
+def _npy(array) -> bytes:
+    import io
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.save(buf, array, allow_pickle=False)
+    return buf.getvalue()
+
+
+def _huge_header() -> bytes:
+    import io
+
+    import numpy as np
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": "<f4", "fortran_order": False, "shape": (10**12, 43)})
+    return buf.getvalue() + b"\0" * 64
+
+
+def _skops(estimator) -> bytes:
+    import skops.io as sio
+
+    return sio.dumps(estimator)
+
+
+def _cases(p: Path):
+    import numpy as np
+    from sklearn.linear_model import LogisticRegression
+
+    from afford.artifacts import read_artifact
+
+    model = read_artifact(str(p / "model.afford"))
+    logistic = LogisticRegression().fit(np.array([[0.0], [1.0], [0.2], [0.9]]), [0, 1, 0, 1])
+    return [
+        ("behaviours-integers", "train.afford", {}, lambda m: m.update(behaviors=[1, 2, 3, 4]), ["inspect"]),
+        ("categories-number", "model.afford", {}, lambda m: m.update(categories=7), ["inspect"]),
+        ("entities-strings", "train.afford", {"entities.npy": _npy(np.array([["a"] * 43] * 3))}, None, ["inspect"]),
+        ("huge-header", "train.afford", {"entities.npy": _huge_header()}, None, ["inspect"]),
+        ("selected-out-of-range", "features.afford", {"selected.push-forward.npy": _npy(np.array([0, 999], np.int32))},
+         None, ["train", "-o", "{out}"]),
+        ("model-selected-out-of-range", "model.afford", {"selected.lift.npy": _npy(np.array([4000], np.int32))},
+         None, ["predict", "--seed", "1"]),
+        ("effects-in-predictor-slot", "model.afford",
+         {"predictor.lift.skops": model.blobs["effects.lift"]}, None, ["predict", "--seed", "1"]),
+        ("logistic-in-predictor-slot", "model.afford", {"predictor.lift.skops": _skops(logistic)}, None,
+         ["predict", "--seed", "1"]),
+        ("edited-counts", "train.afford", {}, lambda m: m.update(n_interactions=9999, n_episodes=-3), ["inspect"]),
+        ("missing-member", "model.afford", {"selected.push-forward.npy": None}, None, ["predict", "--seed", "1"]),
+    ]
+
+
+@pytest.fixture(scope="module")
+def forged(pipeline, tmp_path_factory):
+    d = tmp_path_factory.mktemp("forged")
+    out = {}
+    for name, src, members, manifest, cmd in _cases(pipeline):
+        out[name] = (forge(pipeline / src, d / f"{name}.afford", members, manifest), cmd)
+    return out
+
+
+@pytest.mark.parametrize("case", [
+    "behaviours-integers", "categories-number", "entities-strings", "huge-header", "selected-out-of-range",
+    "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot", "edited-counts",
+    "missing-member"])
+def test_a_forged_file_is_one_sentence_and_exit_1(forged, tmp_path, case):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    path, cmd = forged[case]
+    before = path.read_bytes()
+    args = [cmd[0], str(path)] + [a.format(out=tmp_path / "o.afford") for a in cmd[1:]]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 1, (case, result.output, result.exception)
+    assert isinstance(result.exception, SystemExit), f"{case}: {result.exception!r}"  # no traceback
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and str(path) in errors[0], (case, result.output)
+    assert path.read_bytes() == before and not (tmp_path / "o.afford").exists()
+
+
+def test_unsupported_compression_is_corrupt(pipeline, tmp_path):
+    from afford.artifacts import read_artifact
+    from afford.errors import AffordError
+
+    raw = bytearray((pipeline / "train.afford").read_bytes())
+    at = raw.find(b"PK\x01\x02")
+    while at >= 0:  # every central-directory entry says: compression method 99
+        raw[at + 10:at + 12] = (99).to_bytes(2, "little")
+        at = raw.find(b"PK\x01\x02", at + 4)
+    (tmp_path / "c.afford").write_bytes(bytes(raw))
+    with pytest.raises(AffordError, match="is corrupt"):
+        read_artifact(str(tmp_path / "c.afford"))
+
+
+def test_a_relabelled_schema_1_file_is_refused_and_a_real_one_is_unsealed(pipeline, tmp_path):
+    from afford.artifacts import read_artifact
+    from afford.errors import AffordError
+
+    path = forge(pipeline / "train.afford", tmp_path / "v1.afford", manifest=lambda m: m.update(schema_version=1),
+                 seal=False)
+    with pytest.raises(AffordError, match="claims artefact schema 1 but carries"):
+        read_artifact(str(path))
+    old = forge(pipeline / "train.afford", tmp_path / "old.afford", seal=False, manifest=lambda m: [
+        m.update(schema_version=1), *(m.pop(k, None) for k in ("label_source", "result_names", "n_entities"))])
+    art = read_artifact(str(old))
+    assert not art.sealed

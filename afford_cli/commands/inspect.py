@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from rich.table import Table
 
-from afford.artifacts import Artifact, read_artifact
+from afford.artifacts import Artifact, read_artifact, reading
 from afford.errors import AffordError
 from afford.datasets import behaviour_counts, interactions_from_artifact, outcome_table
 from afford.options import InputPath, Json
@@ -26,7 +26,8 @@ def describe(art: Artifact) -> dict:
         "command": m.get("command"),
         "seed": m.get("seed"),
         "parents": m.get("parents", []),
-        "verified": True,
+        "verified": art.sealed,  # every member's checksum always is; the manifest's only when sealed
+        "sealed": art.sealed,
         "members": sorted(m.get("members", {})),
         "features": [],
         "behavior_names": [b["name"] for b in m.get("behaviors", [])],
@@ -75,7 +76,8 @@ def render(console, info: dict) -> None:
         head.add_row(key, str(info.get(key)))
     head.add_row("command", " ".join(info.get("command") or []))
     head.add_row("parents", ", ".join(f"{p['kind']} {p['sha256'][:12]}" for p in info["parents"]) or "none")
-    head.add_row("checksums", "verified")
+    head.add_row("checksums", "verified" if info["sealed"] else
+                 "members verified; the manifest is unsealed (schema 1), so an edit to it would not show")
     if "n_interactions" in info:
         head.add_row("interactions", f"{info['n_interactions']} in {info['n_episodes']} episodes")
         head.add_row("scene", str(info["scene"].get("name", "?")))
@@ -162,9 +164,10 @@ def inspect(path: InputPath, json: Json = False, plots: PlotDir = None) -> None:
     out = Output(json)
     plot_dir = plot_directory(plots) if plots is not None else None
     art = read_artifact(path)
-    info = describe(art)
-    if plot_dir is not None:
-        info["plots"] = artefact_plots(info, plot_dir)
-    out.result(info, lambda console: render(console, info))
+    with reading(art):  # a forged manifest (checksums recomputed) is one sentence, not a traceback
+        info = describe(art)
+        if plot_dir is not None:
+            info["plots"] = artefact_plots(info, plot_dir)
+        out.result(info, lambda console: render(console, info))
     if plot_dir is not None:
         out.info(written(info["plots"]))
