@@ -97,14 +97,18 @@ class Artifact:
     def parent_ref(self) -> dict[str, str]:
         return {"kind": self.kind, "sha256": self.sha256}
 
-    def estimator(self, name: str, trusted: list[str], expect: type | None = None):
-        """Load estimator member ``name`` with skops, refusing any type not trusted, and one
-        that is not of type ``expect`` (a trusted type in the wrong slot is still wrong)."""
+    def estimator(self, name: str, trusted: list[str], expect: type | None = None,
+                  parts: frozenset[str] | None = None):
+        """Load estimator member ``name`` with skops, refusing any type not trusted, one that
+        is not of type ``expect`` (a trusted type in the wrong slot is still wrong), and, given
+        ``parts``, one built of any class outside them (checked before anything is built)."""
         if name not in self.blobs:
             raise AffordError(f"{self.source} holds no estimator named {name!r}; it is corrupt or was edited")
         blob = self.blobs[name]
         if self.manifest.get("schema_version", SCHEMA_VERSION) < 3:
             blob = _rename_modules(blob, f"{self.source}: {name}")
+        if parts is not None:
+            _check_parts(blob, f"{self.source}: {name}", parts, expect.__name__ if expect else "estimator")
         obj = load_estimator(blob, f"{self.source}: {name}", trusted)
         if expect is not None and type(obj) is not expect:
             raise AffordError(f"{self.source}: {name} holds {_a(type(obj).__name__)} where {_a(expect.__name__)} "
@@ -128,6 +132,38 @@ def reading(art: "Artifact"):
 
 def _a(word: str) -> str:
     return f"{'an' if word[:1].lower() in 'aeiou' else 'a'} {word}"
+
+
+#: skops nodes that hold data, not objects to build
+_DATA_NODES = {"NdArrayNode", "JsonNode", "DictNode", "ListNode", "TupleNode", "SetNode", "SliceNode",
+               "DTypeNode", "BytesNode", "BytearrayNode"}
+
+
+def _check_parts(blob: bytes, where: str, parts: frozenset[str], what: str) -> None:
+    """Refuse a skops blob that would build a class outside ``parts`` (type references may
+    name builtins and numpy types only)."""
+    try:
+        with zipfile.ZipFile(io.BytesIO(blob)) as zf:
+            schema = json.loads(zf.read("schema.json"))
+    except (zipfile.BadZipFile, KeyError, ValueError, OSError, NotImplementedError, EOFError):
+        raise AffordError(f"{where} is not a readable estimator") from None
+    todo = [schema]
+    while todo:
+        node = todo.pop()
+        if isinstance(node, list):
+            todo.extend(node)
+            continue
+        if not isinstance(node, dict):
+            continue
+        todo.extend(node.values())
+        loader = node.get("__loader__")
+        if loader is None or loader in _DATA_NODES:
+            continue
+        name = f"{node.get('__module__')}.{node.get('__class__')}"
+        ok = (str(node.get("__module__")).split(".")[0] in ("builtins", "numpy") if loader == "TypeNode"
+              else name in parts)
+        if not ok:
+            raise AffordError(f"{where} would build {name}, which {_a(what)} is never made of; it was edited")
 
 
 class _Members(dict):

@@ -28,6 +28,9 @@ TRUSTED = sorted(set(PREDICTOR_TYPES) | {"afford.learn.effects.EffectCategories"
 
 ROW_KINDS = ("interactions", "effects", "features")
 
+#: What fitted effect categories are built of (their arrays aside): themselves alone.
+EFFECT_PARTS = frozenset({"afford.learn.effects.EffectCategories"})
+
 
 def read_rows(path: str, kinds: tuple[str, ...] = ROW_KINDS) -> tuple[Artifact, Interactions]:
     art = read_artifact(path, kinds)
@@ -86,7 +89,7 @@ def read_effects(art: Artifact, data: Interactions) -> tuple[np.ndarray, dict | 
         from afford.learn.effects import EffectCategories
 
         with reading(art):
-            models = {name: art.estimator(_blob_name("effects", name), TRUSTED, EffectCategories)
+            models = {name: art.estimator(_blob_name("effects", name), TRUSTED, EffectCategories, EFFECT_PARTS)
                       for name in data.behavior_names}
             labels = art.arrays["category"].astype(int)
             if labels.shape != (len(data),) or (labels.size and (labels.min() < -1 or labels.max() >= 10_000)):
@@ -201,6 +204,7 @@ class LoadedModel:
     def _load(self, art: Artifact) -> None:
         from afford.learn import AffordancePredictor
         from afford.learn.effects import EffectCategories
+        from afford.learn.predictors import PARTS
 
         m = art.manifest
         self.art = art
@@ -212,10 +216,11 @@ class LoadedModel:
         self.selected = {n: art.arrays[f"selected.{n}"].astype(int) for n in self.names}
         given = self.label_source == "given"
         self.prototypes = {n: None if given else art.arrays[f"prototypes.{n}"] for n in self.names}
-        self.effects = {n: None if given else art.estimator(_blob_name("effects", n), TRUSTED, EffectCategories)
-                        for n in self.names}
-        self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED, AffordancePredictor) for n in self.names}
-        self.known = {n: art.estimator(_blob_name("known", n), TRUSTED, AffordancePredictor)
+        self.effects = {n: None if given else art.estimator(_blob_name("effects", n), TRUSTED, EffectCategories,
+                                                             EFFECT_PARTS) for n in self.names}
+        self.predictors = {n: art.estimator(_blob_name("predictor", n), TRUSTED, AffordancePredictor, PARTS)
+                           for n in self.names}
+        self.known = {n: art.estimator(_blob_name("known", n), TRUSTED, AffordancePredictor, PARTS)
                       if _blob_name("known", n) in art.blobs else None for n in self.names}
         # the features P(known) reads (models from before they had their own: the selected)
         self.known_selected = {n: art.arrays[f"known_selected.{n}"].astype(int) if f"known_selected.{n}" in art.arrays

@@ -43,7 +43,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from afford.features.errors import DataError
 from afford.learn.validation import check_finite
 
-__all__ = ["AffordancePredictor", "TRUSTED_TYPES"]
+__all__ = ["AffordancePredictor", "TRUSTED_TYPES", "PARTS"]
 
 #: Types in a fitted :class:`AffordancePredictor` that ``skops.io`` does not trust by
 #: default; pass them to ``skops.io.load(..., trusted=TRUSTED_TYPES)``. A test dumps fitted
@@ -56,6 +56,27 @@ TRUSTED_TYPES: list[str] = [
     "sklearn.calibration._TemperatureScaling",
     "sklearn.model_selection._split.PredefinedSplit",
 ]
+
+#: Every class a fitted :class:`AffordancePredictor` is built of, skops's default-trusted
+#: ones included: a model file's predictor slot may hold these and nothing else (skops trusts
+#: much of scikit-learn by default, which would let another estimator pass as a predictor).
+#: A test dumps predictors of every kernel and calibration, binary and multi-class, and
+#: checks that they hold no other.
+PARTS: frozenset[str] = frozenset({
+    "afford.learn.predictors.AffordancePredictor",
+    "sklearn.calibration.CalibratedClassifierCV",
+    "sklearn.calibration._CalibratedClassifier",
+    "sklearn.calibration._SigmoidCalibration",
+    "sklearn.calibration._TemperatureScaling",
+    "sklearn.isotonic.IsotonicRegression",
+    "sklearn.model_selection._split.PredefinedSplit",
+    "sklearn.multiclass.OneVsRestClassifier",
+    "sklearn.pipeline.Pipeline",
+    "sklearn.preprocessing._data.StandardScaler",
+    "sklearn.preprocessing._label.LabelBinarizer",
+    "sklearn.svm._classes.LinearSVC",
+    "sklearn.svm._classes.SVC",
+})
 
 #: Default gamma grid, as multiples of ``1 / n_features`` (the "scale" value on
 #: standardised inputs).

@@ -234,6 +234,22 @@ def _skops(estimator) -> bytes:
     return sio.dumps(estimator)
 
 
+def _nested_swap(blob: bytes) -> bytes:
+    """A predictor whose inner scaler is swapped for another, skops-trusted, estimator."""
+    import io
+    import zipfile
+
+    with zipfile.ZipFile(io.BytesIO(blob)) as zin:
+        items = {i.filename: zin.read(i.filename) for i in zin.infolist()}
+    items["schema.json"] = (items["schema.json"].replace(b'"sklearn.preprocessing._data"', b'"sklearn.neighbors._classification"')
+                            .replace(b'"StandardScaler"', b'"KNeighborsClassifier"'))
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zout:
+        for n, d in items.items():
+            zout.writestr(n, d)
+    return buf.getvalue()
+
+
 def _cases(p: Path):
     import numpy as np
     from sklearn.linear_model import LogisticRegression
@@ -255,6 +271,8 @@ def _cases(p: Path):
          {"predictor.lift.skops": model.blobs["effects.lift"]}, None, ["predict", "--seed", "1"]),
         ("logistic-in-predictor-slot", "model.afford", {"predictor.lift.skops": _skops(logistic)}, None,
          ["predict", "--seed", "1"]),
+        ("nested-swap", "model.afford", {"predictor.lift.skops": _nested_swap(model.blobs["predictor.lift"])}, None,
+         ["predict", "--seed", "1"]),
         ("edited-counts", "train.afford", {}, lambda m: m.update(n_interactions=9999, n_episodes=-3), ["inspect"]),
         ("missing-member", "model.afford", {"selected.push-forward.npy": None}, None, ["predict", "--seed", "1"]),
     ]
@@ -271,7 +289,8 @@ def forged(pipeline, tmp_path_factory):
 
 @pytest.mark.parametrize("case", [
     "behaviours-integers", "categories-number", "entities-strings", "huge-header", "selected-out-of-range",
-    "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot", "edited-counts",
+    "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot", "nested-swap",
+    "edited-counts",
     "missing-member"])
 def test_a_forged_file_is_one_sentence_and_exit_1(forged, tmp_path, case):
     from typer.testing import CliRunner

@@ -342,6 +342,14 @@ def test_predictor_round_trips_through_skops():
         if calibration == "sigmoid":  # the default needs all but the temperature type
             assert set(TRUSTED_TYPES) - set(untrusted) == {"sklearn.calibration._TemperatureScaling"}
     assert reported == set(TRUSTED_TYPES)
+    # every class a predictor is built of is in PARTS, the model file's allow-list: binary too
+    from afford.artifacts import _check_parts
+    from afford.learn.predictors import PARTS
+
+    for calibration, kernel, yy in (("sigmoid", "rbf", y), ("isotonic", "linear", y), ("temperature", "rbf", y > 0),
+                                    ("temperature", "linear", y > 0), ("sigmoid", "linear", y > 0)):
+        blob = sio.dumps(AffordancePredictor(kernel=kernel, calibration=calibration, random_state=0).fit(X, yy))
+        _check_parts(blob, "fitted", PARTS, "AffordancePredictor")  # raises on a class outside
     with pytest.raises(Exception, match="[Uu]ntrusted"):
         sio.loads(data, trusted=[])
 
