@@ -231,9 +231,28 @@ class LoadedModel:
                 if idx.ndim != 1 or (idx.size and (idx.min() < 0 or idx.max() >= d)):
                     raise AffordError(f"{art.source}: {what}.{n} names features outside the schema's {d}; "
                                       "it is corrupt or was edited")
-            if not given and (self.prototypes[n].ndim != 2 or self.prototypes[n].shape[1] != d):
+            if not given and (self.prototypes[n].ndim != 2 or self.prototypes[n].shape[1] != d
+                              or self.prototypes[n].dtype.kind != "f"):
                 raise AffordError(f"{art.source}: prototypes.{n} does not have the schema's {d} features; "
                                   "it is corrupt or was edited")
+            for what in (f"selected.{n}", f"known_selected.{n}", f"train_y.{n}"):
+                if what in art.arrays and art.arrays[what].dtype.kind not in "iu":
+                    raise AffordError(f"{art.source}: {what} does not hold integers; it is corrupt or was edited")
+            width = len(self.selected[n]) + sum(2 if p.get("periodic") else 1 for p in self.parameters(n))
+            for slot, est, cols in (("predictor", self.predictors[n], width),
+                                    ("known", self.known[n], len(self.known_selected[n]) + width - len(self.selected[n]))):
+                if est is not None and getattr(est, "n_features_in_", cols) != cols:
+                    raise AffordError(f"{art.source}: {slot}.{n} reads {est.n_features_in_} features where the model "
+                                      f"gives it {cols}; it is corrupt or was edited")
+            tx, ty = art.arrays.get(f"train_X.{n}"), art.arrays.get(f"train_y.{n}")
+            if tx is not None and (tx.ndim != 2 or tx.shape[1] != width or ty is None or ty.shape != (tx.shape[0],)):
+                raise AffordError(f"{art.source}: train_X.{n} and train_y.{n} are not a table of the predictor's "
+                                  f"{width} inputs with one label per row; it is corrupt or was edited")
+            cats = m.get("categories", {}).get(n) if isinstance(m.get("categories"), dict) else None
+            expected = len(self.result_names) if given else self.prototypes[n].shape[0]
+            if cats is not None and len(cats) != expected:
+                raise AffordError(f"{art.source} is corrupt or was edited: its manifest lists {len(cats)} categories "
+                                  f"of {n}, its arrays {expected}")
 
     def parameters(self, name: str) -> list[dict]:
         return list(self.behaviors[self.names.index(name)].get("parameters", []))

@@ -250,6 +250,19 @@ def _nested_swap(blob: bytes) -> bytes:
     return buf.getvalue()
 
 
+def _skops_wide(model) -> bytes:
+    """A real predictor, fitted on more inputs than the model's lift predictor reads."""
+    import numpy as np
+
+    from afford.artifacts import dump_estimator
+    from afford.learn import AffordancePredictor
+
+    width = model.arrays["selected.lift"].size + 3
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(40, width))
+    return dump_estimator(AffordancePredictor(kernel="linear", cv=2, random_state=0).fit(X, (X[:, 0] > 0).astype(int)))
+
+
 def _cases(p: Path):
     import numpy as np
     from sklearn.linear_model import LogisticRegression
@@ -273,6 +286,13 @@ def _cases(p: Path):
          ["predict", "--seed", "1"]),
         ("nested-swap", "model.afford", {"predictor.lift.skops": _nested_swap(model.blobs["predictor.lift"])}, None,
          ["predict", "--seed", "1"]),
+        ("train-x-shape", "model.afford", {"train_X.lift.npy": _npy(np.zeros((5, 2), np.float32))}, None,
+         ["evaluate", "{test}", "--baselines"]),
+        ("predictor-swapped-between-behaviours", "model.afford", {"predictor.lift.skops": _skops_wide(model)}, None,
+         ["plan", "--seed", "1", "--goal", "*:visibility=0"]),
+        ("categories-count", "model.afford", {}, lambda m: m["categories"]["lift"].pop(), ["predict", "--seed", "1"]),
+        ("prototypes-strings", "model.afford", {"prototypes.lift.npy": _npy(np.array([["a"] * 43] * 2))}, None,
+         ["predict", "--seed", "1"]),
         ("edited-counts", "train.afford", {}, lambda m: m.update(n_interactions=9999, n_episodes=-3), ["inspect"]),
         ("missing-member", "model.afford", {"selected.push-forward.npy": None}, None, ["predict", "--seed", "1"]),
     ]
@@ -290,16 +310,17 @@ def forged(pipeline, tmp_path_factory):
 @pytest.mark.parametrize("case", [
     "behaviours-integers", "categories-number", "entities-strings", "huge-header", "selected-out-of-range",
     "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot", "nested-swap",
+    "train-x-shape", "predictor-swapped-between-behaviours", "categories-count", "prototypes-strings",
     "edited-counts",
     "missing-member"])
-def test_a_forged_file_is_one_sentence_and_exit_1(forged, tmp_path, case):
+def test_a_forged_file_is_one_sentence_and_exit_1(forged, pipeline, tmp_path, case):
     from typer.testing import CliRunner
 
     from afford.app import app
 
     path, cmd = forged[case]
     before = path.read_bytes()
-    args = [cmd[0], str(path)] + [a.format(out=tmp_path / "o.afford") for a in cmd[1:]]
+    args = [cmd[0], str(path)] + [a.format(out=tmp_path / "o.afford", test=pipeline / "test.afford") for a in cmd[1:]]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 1, (case, result.output, result.exception)
     assert isinstance(result.exception, SystemExit), f"{case}: {result.exception!r}"  # no traceback
