@@ -4,7 +4,7 @@ imitates with what it learned (after Ugur's developmental framework).
 The Python API (:mod:`afford.api`) is importable from here: ``afford.load``,
 ``afford.load_interactions``, ``afford.load_labels``, ``afford.load_model``, ``afford.save``,
 ``afford.explore``, ``afford.world``, ``afford.make_scene``, ``afford.scene_names``,
-``afford.parse_goal``, ``afford.to_frame`` (pandas), ``afford.Model`` and ``afford.AffordError``. They are loaded on first
+``afford.parse_goal``, ``afford.to_frame`` (pandas), ``afford.cluster``, ``afford.select_features``, ``afford.train``, ``afford.Model`` and ``afford.AffordError``. They are loaded on first
 use, so ``import afford.features`` stays light. The packages: ``afford.sim`` (scenes,
 robots, physics), ``afford.features`` (perception), ``afford.learn`` and ``afford.plan``.
 """
@@ -14,8 +14,8 @@ from __future__ import annotations
 from importlib import import_module
 
 __all__ = [
-    "__version__", "AffordError", "Model", "explore", "load", "load_interactions", "load_labels", "load_model",
-    "make_scene", "parse_goal", "save", "scene_names", "to_frame", "world",
+    "__version__", "AffordError", "Model", "cluster", "explore", "load", "load_interactions", "load_labels",
+    "load_model", "make_scene", "parse_goal", "save", "scene_names", "select_features", "to_frame", "train", "world",
 ]
 
 

@@ -32,7 +32,7 @@ from afford.artifacts import read_artifact
 
 __all__ = [
     "AffordError", "load", "load_interactions", "load_labels", "load_model", "save", "Model",
-    "scene_names", "make_scene", "explore", "world", "parse_goal", "to_frame",
+    "scene_names", "make_scene", "explore", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
 ]
 
 
@@ -84,6 +84,97 @@ def save(data, path: str, *, seed: int | None = None) -> None:
         raise AffordError("there are no interactions to save")
     arrays, meta = interactions_members(data)
     write_artifact(path, artifact_bytes("interactions", arrays, meta, seed=seed))
+
+
+# -- learning: one artefact in, the next out (what cluster | select-features | train do) ------
+
+def cluster(path: str, output: str, *, method: str = "hierarchical", k_max: int = 5, k: int | None = None,
+            prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
+            progress: Callable[[int, int], None] | None = None) -> dict:
+    """Discover effect categories per behaviour (thesis 8.4.1, Algorithm 7): reads an
+    ``interactions`` artefact, writes ``effects``; returns the summary ``afford cluster
+    --json`` prints. ``progress(done, total)`` is called per behaviour."""
+    import time
+
+    from afford.artifacts import artifact_bytes, check_output, write_artifact
+    from afford.learn.affordances import discover_effects
+    from afford.learning import effects_members
+
+    check_output(output)
+    art, data = read_rows(path)
+    if not data.has_after:
+        raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
+                          f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
+    start = time.perf_counter()
+    models, labels = discover_effects(data, method=method, k_max=k_max, k=k, prune=prune, min_fraction=min_fraction,
+                                      seed=seed, progress=_per_behaviour(progress, data))
+    settings = {"method": method, "k_max": k_max, "k": k, "prune": prune, "min_fraction": min_fraction}
+    arrays, meta, blobs = effects_members(data, labels, models, settings)
+    write_artifact(output, artifact_bytes("effects", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
+    return {"output": output, "seconds": round(time.perf_counter() - start, 3),
+            "channels": [[ch, [data.schema.names[i] for i in idx]] for ch, idx in data.schema.channel_groups()],
+            "behaviors": {name: {"n_categories": s["n_categories"], "pruned_rows": s["pruned_rows"],
+                                 "categories": s["categories"]} for name, s in meta["effects"].items()}}
+
+
+def _per_behaviour(progress, data):
+    """``progress(done, total)`` as the learners call it, per behaviour finished."""
+    return None if progress is None else (lambda done: progress(done, len(data.behaviors)))
+
+
+def select_features(path: str, output: str, *, method: str = "relieff", top: int | None = None,
+                    group_channels: bool = False, kernel: str | None = None, seed: int = 0,
+                    progress: Callable[[int, int], None] | None = None) -> dict:
+    """Rank the features by relevance to each behaviour's labels (ReliefF, Algorithm 3, or a
+    wrapper) and keep the best: reads effects or interactions with given results, writes
+    ``features``; returns the summary ``afford select-features --json`` prints."""
+    import time
+
+    from afford.artifacts import artifact_bytes, check_output, write_artifact
+    from afford.learn.affordances import rank_features
+    from afford.learning import features_members, learner_settings
+
+    check_output(output)
+    art, data = read_rows(path, ("interactions", "effects", "features"))
+    labels, _ = read_effects(art, data)
+    kernel_name, _ = learner_settings(art, data, kernel)
+    start = time.perf_counter()
+    relevance = rank_features(data, labels, method=method, top=top, seed=seed, group_channels=group_channels,
+                              kernel=kernel_name, progress=_per_behaviour(progress, data))
+    settings = {"method": method, "top": top, "group_channels": group_channels, "kernel": kernel_name}
+    arrays, meta, blobs = features_members(art, data, relevance, settings)
+    write_artifact(output, artifact_bytes("features", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
+    return {"output": output, "seconds": round(time.perf_counter() - start, 3), "method": method,
+            "behaviors": {n: {"selected": r["selected"]} for n, r in meta["relevance"].items()}}
+
+
+def train(path: str, output: str, *, kernel: str | None = None, folds: int | None = None, seed: int = 0,
+          progress: Callable[[int, int], None] | None = None) -> dict:
+    """Train each behaviour's calibrated predictor of its labels: reads features, effects or
+    interactions with given results, writes ``model``; returns the summary ``afford train
+    --json`` prints. ``kernel`` and ``folds`` default to the scene's learner."""
+    import time
+
+    from afford.artifacts import artifact_bytes, check_output, write_artifact
+    from afford.learn.affordances import train_known, train_predictors
+    from afford.learning import learner_settings, model_members, read_selection
+
+    check_output(output)
+    art, data = read_rows(path, ("interactions", "effects", "features"))
+    labels, effects = read_effects(art, data)
+    selected = read_selection(art, data)
+    kernel_name, n_folds = learner_settings(art, data, kernel, folds)
+    start = time.perf_counter()
+    predictors = train_predictors(data, labels, selected, kernel=kernel_name, folds=n_folds, seed=seed,
+                                  progress=_per_behaviour(progress, data))
+    known = train_known(data, labels, seed=seed) if effects is not None else None
+    settings = {"kernel": kernel_name, "folds": n_folds, "selection": art.kind}
+    arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known)
+    write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
+    return {"output": output, "seconds": round(time.perf_counter() - start, 3), "kernel": kernel_name,
+            "behaviors": {n: {"cv_accuracy": cv["cv_accuracy"], "best_params": cv["best_params"],
+                              "n_categories": len(meta["categories"][n]), "n_features": int(len(selected[n]))}
+                          for n, cv in meta["cv"].items()}}
 
 
 def scene_names() -> list[str]:

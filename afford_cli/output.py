@@ -46,13 +46,15 @@ class Output:
         self.err.print(message, soft_wrap=True)
 
     @contextmanager
-    def progress(self, description: str, total: int) -> Iterator[Callable[[int], None]]:
-        """A rich progress bar on stderr; yields ``update(completed)``."""
+    def progress(self, description: str, total: int | None) -> Iterator[Callable[..., None]]:
+        """A rich progress bar on stderr; yields ``update(completed, total=None)`` (a total
+        given later, by the work itself, replaces an unknown one)."""
         columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                    TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn())
         with Progress(*columns, console=self.err, transient=False) as bar:
             task = bar.add_task(description, total=total)
-            yield lambda done: bar.update(task, completed=done)
+            yield lambda done, new_total=None: bar.update(task, completed=done, **(
+                {"total": new_total} if new_total is not None else {}))
 
 
 def _jsonable(value: Any) -> Any:

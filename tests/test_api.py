@@ -103,3 +103,17 @@ def test_version_and_light_import():
     assert re.fullmatch(r"\d+\.\d+\.\d+.*", afford.__version__)
     code = "import sys, afford.features; sys.exit(int('sapien' in sys.modules or 'afford.api' in sys.modules))"
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+def test_the_learning_chain_from_python_is_the_cli_chain(pipeline, tmp_path):
+    """afford.cluster | select_features | train write the members the commands write."""
+    progress = []
+    afford.cluster(str(pipeline / "train.afford"), str(tmp_path / "e.afford"), seed=1,
+                   progress=lambda done, total: progress.append((done, total)))
+    assert progress[-1] == (4, 4)
+    afford.select_features(str(tmp_path / "e.afford"), str(tmp_path / "f.afford"), top=12)
+    summary = afford.train(str(tmp_path / "f.afford"), str(tmp_path / "m.afford"))
+    assert set(summary["behaviors"]) == {"push-forward", "push-left", "push-right", "lift"}
+    for mine, theirs in (("e", "effects"), ("f", "features"), ("m", "model")):
+        ours = read_artifact(str(tmp_path / f"{mine}.afford")).manifest["members"]
+        assert ours == read_artifact(str(pipeline / f"{theirs}.afford")).manifest["members"], theirs

@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import time
 from enum import Enum
 from typing import Annotated, Optional
 
 import typer
 
-from afford.artifacts import artifact_bytes, check_output, write_artifact, writes_stdout
-from afford.errors import AffordError
-from afford.learning import effects_members, read_rows
+from afford.artifacts import check_output, writes_stdout
 from afford.options import InputPath, Json, OutputPath, Seed
 from afford.output import Output
 
@@ -37,32 +34,21 @@ def cluster(
     json: Json = False,
 ) -> None:
     """Discover effect categories per behaviour, without labels (thesis 8.4.1, Algorithm 7)."""
-    from afford.learn.affordances import discover_effects
+    from afford.api import cluster as run
 
     if k is not None and method is not Method.kmeans:
         raise typer.BadParameter("--k goes with --method kmeans")
     check_output(output)
     out = Output(json, stdout_busy=writes_stdout(output))
-    art, data = read_rows(path)
-    if not data.has_after:
-        raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
-                          f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
-    start = time.perf_counter()
-    with out.progress("clustering effects (behaviours)", len(data.behaviors)) as update:
-        models, labels = discover_effects(data, method=method.value, k_max=kmax, k=k, prune=prune.value,
-                                          min_fraction=min_fraction, seed=seed, progress=update)
-    settings = {"method": method.value, "k_max": kmax, "k": k, "prune": prune.value, "min_fraction": min_fraction}
-    arrays, meta, blobs = effects_members(data, labels, models, settings)
-    write_artifact(output, artifact_bytes("effects", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
-    result = {"output": output, "seconds": round(time.perf_counter() - start, 3),
-              "behaviors": {name: {"n_categories": s["n_categories"], "pruned_rows": s["pruned_rows"],
-                                   "categories": s["categories"]} for name, s in meta["effects"].items()}}
+    with out.progress("clustering effects (behaviours)", None) as update:
+        result = run(path, output, method=method.value, k_max=kmax, k=k, prune=prune.value,
+                     min_fraction=min_fraction, seed=seed, progress=update)
 
     def render(console):
         from afford.reports import render_categories
 
-        for name, s in meta["effects"].items():
-            render_categories(console, name, s["categories"], [(ch, [data.schema.names[i] for i in idx]) for ch, idx in data.schema.channel_groups()])
+        for name, s in result["behaviors"].items():
+            render_categories(console, name, s["categories"], [(ch, names) for ch, names in result["channels"]])
         console.print(f"-> {output} ({result['seconds']:.1f} s)")
 
     out.result(result, render)
