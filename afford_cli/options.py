@@ -10,7 +10,7 @@ import typer
 __all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives", "SceneSeed", "Objects",
            "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source", "Kernel", "KernelOption"]
 
-Seed = Annotated[int, typer.Option("--seed", "-s", min=0, help="Random seed; the same seed gives the same arrays whatever --workers is.")]
+Seed = Annotated[int, typer.Option("--seed", "-s", min=0, help="Random seed: the same seed gives the same arrays (whatever --workers is, where a command has workers).")]
 Workers = Annotated[int, typer.Option("--workers", "-w", min=1, max=64, help="Parallel worker processes.")]
 Json = Annotated[bool, typer.Option("--json", help="Print one JSON object instead of the human report.")]
 OutputPath = Annotated[str, typer.Option("--output", "-o", help="Where to write the artefact; '-' for stdout.")]

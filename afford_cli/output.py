@@ -2,7 +2,8 @@
 
 That thing is the human report, or ``--json`` (one JSON object), or the artefact bytes when
 ``-o -``. Progress bars, warnings and errors go to stderr; when stdout carries the artefact,
-the report (human or JSON) goes to stderr too.
+the report (human or JSON) goes to stderr too, and with ``--json`` no progress bar is drawn
+there, so stderr holds one JSON object (or an error).
 """
 
 from __future__ import annotations
@@ -51,7 +52,8 @@ class Output:
         given later, by the work itself, replaces an unknown one)."""
         columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                    TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn())
-        with Progress(*columns, console=self.err, transient=False) as bar:
+        # with --json while stdout carries the artefact, stderr carries the JSON alone
+        with Progress(*columns, console=self.err, transient=False, disable=self.json_mode and self.stdout_busy) as bar:
             task = bar.add_task(description, total=total)
             yield lambda done, new_total=None: bar.update(task, completed=done, **(
                 {"total": new_total} if new_total is not None else {}))

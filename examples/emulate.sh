@@ -7,7 +7,9 @@
 set -euo pipefail
 model=${1:?usage: emulate.sh MODEL [clear|lift|close|all]}
 task=${2:-all}
-afford=${AFFORD:-.venv/bin/afford}
+# the repository's afford, wherever this is run from (AFFORD overrides it)
+repo=$(cd "$(dirname "$0")/.." && pwd)
+afford=${AFFORD:-$repo/.venv/bin/afford}
 here=$(dirname "$0")/layouts
 run() { echo "== $1"; "$afford" emulate "$model" --observe "$here/$2" --start "$here/$3"; }
 case "$task" in

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # From nothing to a model: explore, discover effect categories, pick features, train,
-# and measure the model on interactions it has not seen. Run from the repository root
-# after `make setup` (or `make test`): bash examples/pipeline.sh [OUT_DIR]
+# and measure the model on interactions it has not seen. After `make setup` (or
+# `make test`), from anywhere: bash examples/pipeline.sh [OUT_DIR]
 set -euo pipefail
 out=${1:-example-out}
-afford=${AFFORD:-.venv/bin/afford}
+# the repository's afford, wherever this is run from (AFFORD overrides it)
+repo=$(cd "$(dirname "$0")/.." && pwd)
+afford=${AFFORD:-$repo/.venv/bin/afford}
 mkdir -p "$out"
 "$afford" explore --scene table --interactions 5000 --seed 1 --workers 2 -o "$out/train.afford"
 "$afford" explore --scene table --interactions 1000 --seed 2 --workers 2 -o "$out/test.afford"

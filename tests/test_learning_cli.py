@@ -70,6 +70,10 @@ def test_model_reports_features_and_predicts(pipeline):
         assert m["accuracy"] > m["baselines"]["majority"]  # it learned something
         cm = np.array(m["confusion_matrix"])
         assert cm.sum() == m["n_test"]
+        # open-set: every interaction scored, a discarded kind one more outcome
+        assert m["n_all"] == m["n_test"] + m["n_unknown_effects"] and 0.0 <= m["accuracy_all"] <= 1.0
+        right_on_kept = m["accuracy"] * m["n_test"]
+        assert m["accuracy_all"] * m["n_all"] <= right_on_kept + m["n_unknown_effects"] + 1e-6
 
 
 def test_predict_with_check_runs_the_simulator(pipeline):

@@ -75,6 +75,7 @@ def test_learning_with_given_results_needs_no_cluster_step(learned):
                          "--json"]).stdout)
     for name, m in out["behaviors"].items():
         assert m["n_test"] == 8 and 0.0 <= m["accuracy"] <= 1.0
+        assert m["n_all"] == 8 and m["accuracy_all"] == m["accuracy"]  # given results: nothing is discarded
         assert {"majority", "random_forest"} <= set(m["baselines"])
 
 

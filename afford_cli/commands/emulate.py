@@ -48,7 +48,8 @@ def emulate(
     plan = ranked[0]
     result = {"goal": goal.to_json(), "plan": plan.to_json()["steps"], "found": plan.found,
               "success_probability": round(plan.success_probability, 4),
-              "open_loop_probability": plan.to_json()["open_loop_probability"], "reached": False, "replans": 0,
+              "open_loop_probability": plan.to_json()["open_loop_probability"],
+              "reached": False if execute else None, "replans": 0 if execute else None,
               "search": plan.to_json()}
     entry = {"plan": plan.to_json(), "tree": plan.tree[:8]}
     if alternatives > 1:

@@ -58,12 +58,28 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
             "ece": m["ece"], "confusion_matrix": m["confusion_matrix"], "labels": m["labels"],
             "reliability": reliability_bins(y[known], proba, predictor.classes_),
         }
+        entry.update(_open_set(model, name, data, rows, X, y, predictor))
         if baselines:
             arrays = model.art.arrays
             entry["baselines"] = baseline_scores(arrays[f"train_X.{name}"], arrays[f"train_y.{name}"].astype(int),
                                                  X[known], y[known], random_state=seed)
         out[name] = entry
     return out
+
+
+def _open_set(model, name: str, data, rows: np.ndarray, X: np.ndarray, y: np.ndarray, predictor) -> dict:
+    """Accuracy over every interaction, an effect of a kind the model discarded counting as
+    one more outcome, which the model predicts where P(known) < 0.5 (``accuracy_all``, ``n_all``)."""
+    from afford.learn.affordances import predictor_inputs
+
+    guess = predictor.classes_[np.argmax(predictor.predict_proba(X), axis=1)].astype(int)
+    known_model = model.known.get(name)
+    if known_model is not None:
+        Xk = predictor_inputs(data.before_rows(rows), data.params[rows], model.known_selected[name], model.parameters(name))
+        p_known = known_model.predict_proba(Xk)[:, list(known_model.classes_).index(1)]
+        guess = np.where(p_known < 0.5, -1, guess)
+    return {"accuracy_all": round(float(np.mean(guess == y)), 4), "n_all": int(rows.size),
+            "predicted_unknown": int((guess < 0).sum())}
 
 
 def evaluate(
@@ -89,8 +105,10 @@ def evaluate(
         render_metrics(console, result["behaviors"], f"held-out evaluation on {len(rows)} interactions")
         unknown = {n: m["n_unknown_effects"] for n, m in result["behaviors"].items() if m["n_unknown_effects"]}
         if unknown:
-            console.print("not scored (effects of kinds the model discarded as rare): "
+            console.print("not scored above (effects of kinds the model discarded as rare): "
                           + ", ".join(f"{n} {c}" for n, c in unknown.items()))
+        console.print("over every interaction, a discarded kind predicted where P(known) < 0.5: "
+                      + ", ".join(f"{n} {100 * m['accuracy_all']:.1f}% of {m['n_all']}" for n, m in result["behaviors"].items()))
 
     out.result(result, render)
     if plot_dir is not None:

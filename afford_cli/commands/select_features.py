@@ -23,7 +23,7 @@ def select_features(
     path: InputPath,
     output: OutputPath,
     method: Annotated[Method, typer.Option(help="ReliefF (Algorithm 3), forward selection (sequentialfs) or backward elimination (schemata search).")] = Method.relieff,
-    top: Annotated[Optional[int], typer.Option("--top", min=1, help="Keep this many features, best first.")] = None,
+    top: Annotated[Optional[int], typer.Option("--top", min=1, help="Keep this many features, best first (default: ReliefF's ranking cut where cross-validated accuracy is within one standard error of the best; the wrappers' own stopping rule).")] = None,
     group_channels: Annotated[bool, typer.Option("--group-channels", help="Wrappers move each 18-bin histogram as one unit.")] = False,
     kernel: KernelOption = None,
     seed: Seed = 0,
