@@ -69,6 +69,12 @@ def test_predict_proba_is_what_afford_predict_reports(pipeline):
             classes, proba = model.predict_proba(name, state[entry["object"]])
             assert {str(c): round(float(q), 4) for c, q in zip(classes, proba[0])} == p["probabilities"]
             assert int(model.predict(name, state[entry["object"]])[0]) == p["category"]
+            # the next state predict shows is the planner's: its forward model's step
+            fm = model.forward(min_probability=0.0)
+            i, b = entry["object"], fm.index(name)
+            nxt = fm.apply(state, i, b, p["category"])[i]
+            assert p["next"]["visible"] == bool(model.schema.visible(nxt))
+            assert p["next"]["features"] == {model.schema.names[j]: round(float(nxt[j]), 4) for j in model.schema.geometry}
 
 
 def test_a_feature_vector_of_the_wrong_length_is_one_sentence(pipeline):
