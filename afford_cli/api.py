@@ -22,17 +22,19 @@ Errors are :class:`AffordError` (a refused file, an impossible request) or
 
 from __future__ import annotations
 
+import os
 from typing import Callable, Sequence
 
 import numpy as np
 
 from afford.errors import AffordError
+from afford.features.errors import DataError
 from afford.learning import LoadedModel, read_effects, read_rows
 from afford.artifacts import read_artifact
 
 __all__ = [
     "AffordError", "load", "load_interactions", "load_labels", "load_model", "save", "Model",
-    "scene_names", "make_scene", "explore", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
+    "scene_names", "make_scene", "explore", "scene_and_layout", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
 ]
 
 
@@ -210,27 +212,40 @@ def explore(scene, *, episodes: int | None = None, interactions: int | None = No
     return data
 
 
-def world(scene="table", *, seed: int | None = 0, layout=None, **drawn):
-    """A simulated world to perceive and act in (``perceive()``, ``act(behaviour, target)``).
-
-    ``layout`` is a layout file's path or a layout the scene parsed; without one the
-    layout is drawn from ``seed`` (and ``drawn`` options such as ``objects=3``), the same
-    one ``afford plan --seed`` draws."""
+def scene_and_layout(scene="table", seed: int | None = 0, layout=None, *, allow_empty: bool = False, **drawn):
+    """The scene and a layout of it: ``layout`` is a layout file's path or a layout the scene
+    parsed; without one it is drawn from ``seed`` (with ``drawn`` options such as
+    ``objects=3``), the same one ``afford plan --seed`` draws. An option the scene does not
+    take raises :class:`afford.sim.scene.SceneOptionError`; a bad layout, one sentence."""
     from afford.sim.scene import check_options, load_layout_file
-    from afford.sim.session import SimWorld
 
     sc = make_scene(scene) if isinstance(scene, str) else scene
     given = {k: v for k, v in drawn.items() if v not in (None, False)}
     check_options(sc, given)
+    from_file = isinstance(layout, (str, os.PathLike))
     if layout is None:
         if seed is None:
             raise AffordError("give a layout, or a seed to draw a random one")
         specs = sc.sample(_layout_rng(seed), **given)
-    elif isinstance(layout, str) or hasattr(layout, "__fspath__"):
+    elif from_file:
         specs = load_layout_file(sc, layout)
+        if sc.loop == "play" and not specs and not allow_empty:
+            raise AffordError(f"{layout} has no [[object]] entries; the robot needs something to act on")
     else:
         specs = layout
-    sc.check_layout(specs)
+    try:
+        sc.check_layout(specs)
+    except DataError as exc:
+        raise DataError(f"{layout if from_file else 'the scene'}: {exc}") from None
+    return sc, specs
+
+
+def world(scene="table", *, seed: int | None = 0, layout=None, **drawn):
+    """A simulated world to perceive and act in (``perceive()``, ``act(behaviour, target)``),
+    of the scene and layout :func:`scene_and_layout` gives."""
+    from afford.sim.session import SimWorld
+
+    sc, specs = scene_and_layout(scene, seed, layout, **drawn)
     return SimWorld(sc, specs, seed or 0)
 
 

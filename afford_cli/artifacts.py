@@ -139,23 +139,46 @@ _DATA_NODES = {"NdArrayNode", "JsonNode", "DictNode", "ListNode", "TupleNode", "
                "DTypeNode", "BytesNode", "BytearrayNode"}
 
 
-def _check_parts(blob: bytes, where: str, parts: frozenset[str], what: str) -> None:
-    """Refuse a skops blob that would build a class outside ``parts`` (type references may
-    name builtins and numpy types only)."""
+def _skops_open(blob: bytes, where: str) -> tuple[Any, dict[str, bytes]]:
+    """A skops blob's parsed ``schema.json`` and its other members."""
     try:
         with zipfile.ZipFile(io.BytesIO(blob)) as zf:
-            schema = json.loads(zf.read("schema.json"))
+            members = {info.filename: zf.read(info.filename) for info in zf.infolist()}
+        return json.loads(members.pop("schema.json")), members
     except (zipfile.BadZipFile, KeyError, ValueError, OSError, NotImplementedError, EOFError):
         raise AffordError(f"{where} is not a readable estimator") from None
+
+
+def _skops_pack(schema, members: dict[str, bytes]) -> bytes:
+    """A skops blob of ``schema`` and ``members``, canonical: entries in name order, one
+    fixed time, so equal contents give equal bytes."""
+    out = {"schema.json": json.dumps(schema, indent=2).encode(), **members}
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_STORED) as zout:
+        for name in sorted(out):
+            info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
+            info.external_attr = 0o644 << 16
+            zout.writestr(info, out[name])
+    return buf.getvalue()
+
+
+def _nodes(schema):
+    """Every dict (skops node) in a skops schema."""
     todo = [schema]
     while todo:
         node = todo.pop()
         if isinstance(node, list):
             todo.extend(node)
-            continue
-        if not isinstance(node, dict):
-            continue
-        todo.extend(node.values())
+        elif isinstance(node, dict):
+            todo.extend(node.values())
+            yield node
+
+
+def _check_parts(blob: bytes, where: str, parts: frozenset[str], what: str) -> None:
+    """Refuse a skops blob that would build a class outside ``parts`` (type references may
+    name builtins and numpy types only)."""
+    schema, _ = _skops_open(blob, where)
+    for node in _nodes(schema):
         loader = node.get("__loader__")
         if loader is None or loader in _DATA_NODES:
             continue
@@ -183,87 +206,45 @@ _OLD_PACKAGES = ("sim", "features", "learn", "plan")
 
 def _rename_modules(blob: bytes, where: str) -> bytes:
     """A skops blob from before schema 3 with its classes' modules renamed (``learn.x`` ->
-    ``afford.learn.x``). skops keeps each object's module in ``schema.json``; the rest of
-    the blob is left byte for byte."""
-
-    def rename(node):
-        if isinstance(node, dict):
-            out = {k: rename(v) for k, v in node.items()}
-            module = out.get("__module__")
-            if isinstance(module, str) and module.split(".")[0] in _OLD_PACKAGES:
-                out["__module__"] = f"afford.{module}"
-            return out
-        if isinstance(node, list):
-            return [rename(v) for v in node]
-        return node
-
-    try:
-        with zipfile.ZipFile(io.BytesIO(blob)) as zin:
-            members = [(info, zin.read(info.filename)) for info in zin.infolist()]
-        buf = io.BytesIO()
-        with zipfile.ZipFile(buf, "w") as zout:
-            for info, data in members:
-                if info.filename == "schema.json":
-                    data = json.dumps(rename(json.loads(data))).encode()
-                zout.writestr(info, data)
-    except (zipfile.BadZipFile, KeyError, OSError, EOFError, ValueError, UnicodeDecodeError):
-        raise AffordError(f"{where} is not a readable estimator") from None
-    return buf.getvalue()
+    ``afford.learn.x``); skops keeps each object's module in ``schema.json``."""
+    schema, members = _skops_open(blob, where)
+    for node in _nodes(schema):
+        module = node.get("__module__")
+        if isinstance(module, str) and module.split(".")[0] in _OLD_PACKAGES:
+            node["__module__"] = f"afford.{module}"
+    return _skops_pack(schema, members)
 
 
 def dump_estimator(estimator) -> bytes:
-    """skops bytes of ``estimator``, canonical: the same estimator gives the same bytes."""
+    """skops bytes of ``estimator``, canonical: the same estimator gives the same bytes.
+
+    skops names each object (``__id__``) and each array member (``<id>.npy``) by its Python
+    ``id()`` and stamps the zip entries with the wall clock, so equal estimators gave other
+    bytes every run. Here ids are numbered in the order the schema first meets them (a
+    depth-first walk), array members follow their nodes, and :func:`_skops_pack` fixes the
+    rest."""
     import skops.io as sio
 
-    return _canonical_skops(sio.dumps(estimator))
-
-
-def _canonical_skops(blob: bytes) -> bytes:
-    """skops names each object (``__id__``) and each array member (``<id>.npy``) by its
-    Python ``id()`` and stamps the zip entries with the wall clock, so equal estimators gave
-    other bytes every run. Here ids become their order of first appearance, array members
-    follow them, and entries carry a fixed time, in name order: equal estimators, equal bytes."""
-    with zipfile.ZipFile(io.BytesIO(blob)) as zin:
-        members = {info.filename: zin.read(info.filename) for info in zin.infolist()}
-    schema = json.loads(members.pop("schema.json"))
+    schema, members = _skops_open(sio.dumps(estimator), "a fitted estimator")
     ids: dict[int, int] = {}
-
-    def walk(node):
-        if isinstance(node, dict):
-            out = {}
-            for k, v in node.items():
-                if k == "__id__" and isinstance(v, int):
-                    out[k] = ids.setdefault(v, len(ids))
-                else:
-                    out[k] = walk(v)
-            return out
-        if isinstance(node, list):
-            return [walk(v) for v in node]
-        return node
-
-    schema = walk(schema)
     files: dict[str, str] = {}
 
-    def rename(node):
-        if isinstance(node, dict):
-            return {k: (files.setdefault(v, f"a{len(files)}.npy") if k == "file" and isinstance(v, str) and v in members
-                        else rename(v))
-                    for k, v in node.items()}
+    def walk(node):
         if isinstance(node, list):
-            return [rename(v) for v in node]
-        return node
+            for v in node:
+                walk(v)
+        elif isinstance(node, dict):
+            for k, v in node.items():
+                if k == "__id__" and isinstance(v, int):
+                    node[k] = ids.setdefault(v, len(ids))
+                elif k == "file" and isinstance(v, str) and v in members:
+                    node[k] = files.setdefault(v, f"a{len(files)}.npy")
+                else:
+                    walk(v)
 
-    schema = rename(schema)
-    out = {"schema.json": json.dumps(schema, indent=2, sort_keys=False).encode()}
-    out.update({new: members[old] for old, new in files.items()})
-    out.update({k: v for k, v in members.items() if k not in files})  # any member no node names
-    buf = io.BytesIO()
-    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_STORED) as zout:
-        for name in sorted(out):
-            info = zipfile.ZipInfo(name, date_time=_ZIP_TIME)
-            info.external_attr = 0o644 << 16
-            zout.writestr(info, out[name])
-    return buf.getvalue()
+    walk(schema)
+    renamed = {files.get(name, name): data for name, data in members.items()}
+    return _skops_pack(schema, renamed)
 
 
 def load_estimator(blob: bytes, where: str, trusted: list[str]):

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from afford.errors import AffordError
 from afford.features.errors import DataError
 
@@ -28,42 +26,25 @@ def make_scene(name: str, **options):
 
 
 def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_empty: bool = False, **drawn):
-    """The scene and a layout of it, from a layout file or drawn from the seed.
+    """The scene and a layout of it, from a layout file or drawn from the seed
+    (:func:`afford.api.scene_and_layout`, its errors as the command line reports them).
 
     ``drawn`` holds the drawing options a command offers (``objects``, ``reachable``);
     one the scene does not take is a usage error, unless it was left unset.
     """
     import typer
 
-    from afford.sim.layout import LayoutError
-    from afford.sim.scene import SceneOptionError, check_options, load_layout_file
+    from afford.api import scene_and_layout
+    from afford.sim.scene import SceneOptionError
 
-    scene = make_scene(scene_name)
-    given = {k: v for k, v in drawn.items() if v not in (None, False)}
+    if layout is None and seed is None:
+        raise AffordError("give --layout FILE, or --seed S to draw a random scene")
     try:
-        check_options(scene, given)
+        return scene_and_layout(make_scene(scene_name), seed, layout, allow_empty=allow_empty, **drawn)
     except SceneOptionError as exc:
         raise typer.BadParameter(str(exc)) from None
-    if layout is not None:
-        try:
-            specs = load_layout_file(scene, layout)
-        except LayoutError as exc:
-            raise AffordError(str(exc)) from None
-        if scene.loop == "play" and not specs and not allow_empty:
-            raise AffordError(f"{layout} has no [[object]] entries; the robot needs something to act on")
-    else:
-        if seed is None:
-            raise AffordError("give --layout FILE, or --seed S to draw a random scene")
-        rng = np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(7,)))
-        try:
-            specs = scene.sample(rng, **given)
-        except DataError as exc:
-            raise AffordError(str(exc)) from None
-    try:
-        scene.check_layout(specs)
     except DataError as exc:
-        raise AffordError(f"{layout or 'the scene'}: {exc}") from None
-    return scene, specs
+        raise AffordError(str(exc)) from None
 
 
 def open_world(scene, specs, seed: int):

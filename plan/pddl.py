@@ -80,7 +80,8 @@ class PddlTask:
                 "truncated": self.truncated}
 
     def _operators(self) -> int:
-        return len(re.findall(r"^\s*\(:action ", self.domain, re.M))
+        """The deterministic domain's operators, one per (behaviour, category) it uses."""
+        return len(set(self.actions) & set(re.findall(r"^\s*\(:action (\S+)", self.domain, re.M)))
 
 
 def _symbol(text: str) -> str:
