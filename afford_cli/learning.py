@@ -122,13 +122,18 @@ def read_selection(art: Artifact, data: Interactions) -> dict[str, np.ndarray]:
         out = {}
         with reading(art):
             for name in data.behavior_names:
-                idx = art.arrays[f"selected.{name}"].astype(int)
-                if idx.ndim != 1 or (idx.size and (idx.min() < 0 or idx.max() >= d)):
-                    raise AffordError(f"{art.source}: selected.{name} names features outside the schema's {d}; "
-                                      "it is corrupt or was edited")
-                out[name] = idx
+                out[name] = _feature_indices(art, f"selected.{name}", d)
         return out
     return {name: np.arange(len(data.schema)) for name in data.behavior_names}
+
+
+def _feature_indices(art: Artifact, member: str, d: int) -> np.ndarray:
+    """Array ``member``: integer indices of features, each within the schema's ``d``."""
+    idx = art.arrays[member]
+    if idx.ndim != 1 or idx.dtype.kind not in "iu" or (idx.size and (idx.min() < 0 or idx.max() >= d)):
+        raise AffordError(f"{art.source}: {member} names features outside the schema's {d}; "
+                          "it is corrupt or was edited")
+    return idx.astype(int)
 
 
 # manifest fields every artefact writes for itself
@@ -227,17 +232,15 @@ class LoadedModel:
                                else self.selected[n] for n in self.names}
         d = len(self.schema)
         for n in self.names:
-            for what, idx in (("selected", self.selected[n]), ("known_selected", self.known_selected[n])):
-                if idx.ndim != 1 or (idx.size and (idx.min() < 0 or idx.max() >= d)):
-                    raise AffordError(f"{art.source}: {what}.{n} names features outside the schema's {d}; "
-                                      "it is corrupt or was edited")
+            for what in (f"selected.{n}", f"known_selected.{n}"):
+                if what in art.arrays:
+                    _feature_indices(art, what, d)
             if not given and (self.prototypes[n].ndim != 2 or self.prototypes[n].shape[1] != d
                               or self.prototypes[n].dtype.kind != "f"):
                 raise AffordError(f"{art.source}: prototypes.{n} does not have the schema's {d} features; "
                                   "it is corrupt or was edited")
-            for what in (f"selected.{n}", f"known_selected.{n}", f"train_y.{n}"):
-                if what in art.arrays and art.arrays[what].dtype.kind not in "iu":
-                    raise AffordError(f"{art.source}: {what} does not hold integers; it is corrupt or was edited")
+            if art.arrays.get(f"train_y.{n}") is not None and art.arrays[f"train_y.{n}"].dtype.kind not in "iu":
+                raise AffordError(f"{art.source}: train_y.{n} does not hold integers; it is corrupt or was edited")
             width = len(self.selected[n]) + sum(2 if p.get("periodic") else 1 for p in self.parameters(n))
             for slot, est, cols in (("predictor", self.predictors[n], width),
                                     ("known", self.known[n], len(self.known_selected[n]) + width - len(self.selected[n]))):
