@@ -34,7 +34,7 @@ from afford.artifacts import read_artifact
 
 __all__ = [
     "AffordError", "load", "load_interactions", "load_labels", "load_model", "save", "Model",
-    "scene_names", "make_scene", "explore", "scene_and_layout", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
+    "scene_names", "make_scene", "explore", "merge", "scene_and_layout", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
 ]
 
 
@@ -77,14 +77,18 @@ def load_model(path: str) -> "Model":
     return load(path)
 
 
-def save(data, path: str, *, seed: int | None = None) -> None:
-    """Write interactions to an ``interactions`` artefact (atomically; ``-`` is stdout)."""
+def save(data, path: str, *, seed: int | None = None, episodes: tuple[int, int] | None = None) -> None:
+    """Write interactions to an ``interactions`` artefact (atomically; ``-`` is stdout).
+    ``episodes`` (start, stop) records that the rows are those episodes whole, as an
+    exploration by episodes gives them: what :func:`merge` needs of a shard."""
     from afford.artifacts import artifact_bytes, write_artifact
     from afford.datasets import interactions_members
 
     if len(data) == 0:
         raise AffordError("there are no interactions to save")
     arrays, meta = interactions_members(data)
+    if episodes is not None:
+        meta["episodes"] = {"start": int(episodes[0]), "stop": int(episodes[1])}
     write_artifact(path, artifact_bytes("interactions", arrays, meta, seed=seed))
 
 
@@ -195,21 +199,86 @@ def make_scene(name: str, **options):
 
 def explore(scene, *, episodes: int | None = None, interactions: int | None = None, seed: int = 0,
             workers: int = 1, max_steps: int | None = None,
-            progress: Callable[[int, int], None] | None = None, **options):
+            progress: Callable[[int, int], None] | None = None, episode_start: int = 0,
+            backend: str = "loky", scheduler: str | None = None, journal: str | os.PathLike | None = None,
+            resume: bool = False, **options):
     """Explore a scene (a name, with its ``options``, or a scene object) with its own loop
-    (Algorithm 5 or 1): the :class:`Interactions` recorded. Give ``episodes`` (100 when
-    neither is given) or ``interactions``; the same seed gives the same rows for any number
-    of workers. ``progress(done, total)`` is called as work finishes."""
+    (Algorithm 5 or 1): the :class:`Interactions` recorded.
+
+    Give ``episodes`` (100 when neither is given) or ``interactions``; ``episode_start``
+    makes the run one shard of a larger exploration (episodes ``episode_start`` on), to be
+    joined with :func:`merge`. The same seed gives the same rows whatever ``workers`` and
+    ``backend`` (``"loky"`` on this machine, ``"dask"`` on a LocalCluster of ``workers`` on
+    127.0.0.1, or on the running cluster at ``scheduler``). ``journal`` is a folder that
+    keeps each finished episode as it arrives: after an interruption (a
+    :class:`~afford.errors.Interrupted` names what was kept), ``resume=True`` runs only the
+    rest, to the same bytes. Remove the journal once the result is saved.
+    ``progress(done, total)`` is called as work finishes.
+    """
+    from afford.backends import open_pool
+    from afford.errors import Interrupted
     from afford.sim.explore import explore as run
 
     sc = make_scene(scene, **options) if isinstance(scene, str) else scene
     if episodes is None and interactions is None:
         episodes = 100
-    data = run(sc, episodes=episodes, interactions=interactions, seed=seed, workers=workers,
-               max_steps=max_steps, progress=progress)
+    book = None
+    if journal is not None:
+        from pathlib import Path
+
+        from afford.journal import Journal
+
+        identity = {"scene": sc.describe(), "seed": seed, "episodes": episodes, "interactions": interactions,
+                    "episode_start": episode_start, "max_steps": max_steps}
+        book = Journal.start(Path(journal), identity, resume)
+    try:
+        with open_pool(backend, workers, scheduler) as pool:
+            data = run(sc, episodes=episodes, interactions=interactions, seed=seed, max_steps=max_steps,
+                       progress=progress, episode_start=episode_start, pool=pool,
+                       done=book.kept if book else None, on_done=book.append if book else None)
+    except KeyboardInterrupt:
+        if book is None:
+            raise
+        book.close()
+        n = len(book.kept)
+        if n == 0 and book.created:
+            book.remove()
+            raise
+        raise Interrupted(f"interrupted; {n} finished episode{'s are' if n != 1 else ' is'} kept in {book.dir}: "
+                          "run the same command with --resume to go on") from None
+    except BaseException:
+        if book is not None and book.created and not book.kept:  # nothing was kept: leave no trace
+            book.remove()
+        raise
+    finally:
+        if book is not None:
+            book.close()
     if len(data) == 0:
         raise AffordError("exploration recorded no interactions (no object was ever seen)")
     return data
+
+
+def merge(paths: Sequence[str], output: str) -> dict:
+    """Join shards of one exploration (``explore --episode-start/--episode-count``, or
+    ``episode_start``) into one ``interactions`` artefact, the same rows a one-shot run gives;
+    returns the summary ``afford merge --json`` prints. The shards must share scene, schema
+    and seed, and their episodes must neither overlap nor leave a gap."""
+    from afford.artifacts import artifact_bytes, check_output, write_artifact
+    from afford.datasets import check_shards, interactions_members
+    from afford.features import Interactions
+
+    check_output(output)
+    if len(paths) < 1:
+        raise AffordError("give the shards to merge")
+    shards = [read_rows(p, ("interactions",)) for p in paths]
+    order, (start, stop), seed = check_shards(shards)
+    data = Interactions.concatenate([shards[i][1] for i in order])
+    arrays, meta = interactions_members(data)
+    meta["episodes"] = {"start": start, "stop": stop}
+    write_artifact(output, artifact_bytes("interactions", arrays, meta, seed=seed,
+                                          parents=[shards[i][0].parent_ref() for i in order]))
+    return {"output": output, "shards": len(shards), "interactions": len(data), "episodes": [start, stop],
+            "seed": seed}
 
 
 def scene_and_layout(scene="table", seed: int | None = 0, layout=None, *, allow_empty: bool = False, **drawn):

@@ -14,9 +14,10 @@ from typing import Annotated, Callable
 import typer
 
 from afford.commands import (
-    cluster, demo, emulate, evaluate, explore, export, inspect, pddl, plan, predict, scenes, select_features, train,
+    cluster, demo, emulate, evaluate, explore, export, inspect, merge, pddl, plan, predict, scenes, select_features,
+    train,
 )
-from afford.errors import AffordError
+from afford.errors import AffordError, Interrupted
 from afford.features.errors import DataError
 
 app = typer.Typer(
@@ -59,8 +60,9 @@ def _guarded(command: Callable) -> Callable:
             message = str(exc)
             sys.stderr.write(f"error: {message}\n")
             raise typer.Exit(1) from None
-        except KeyboardInterrupt:  # Ctrl-C or SIGTERM: outputs are written whole or not at all
-            sys.stderr.write("\nerror: interrupted; the output being written was discarded\n")
+        except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: outputs are written whole or not at all
+            message = str(exc) if isinstance(exc, Interrupted) else "interrupted; the output being written was discarded"
+            sys.stderr.write(f"\nerror: {message}\n")
             raise typer.Exit(130) from None
 
     return run
@@ -70,7 +72,7 @@ for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
                         ("select-features", select_features.select_features), ("train", train.train),
                         ("evaluate", evaluate.evaluate), ("predict", predict.predict),
                         ("plan", plan.plan), ("emulate", emulate.emulate), ("pddl", pddl.pddl),
-                        ("inspect", inspect.inspect), ("export", export.export), ("demo", demo.demo)):
+                        ("merge", merge.merge), ("inspect", inspect.inspect), ("export", export.export), ("demo", demo.demo)):
     app.command(_name)(_guarded(_command))
 
 

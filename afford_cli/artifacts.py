@@ -38,7 +38,7 @@ from afford.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
-    "artifact_bytes", "dump_estimator", "load_estimator", "check_output", "writes_stdout",
+    "artifact_bytes", "dump_estimator", "load_estimator", "check_output", "writes_stdout", "output_is_file",
 ]
 
 FORMAT = "afford"
@@ -366,6 +366,12 @@ def writes_stdout(path: str) -> bool:
     except (OSError, ValueError, AttributeError):
         return False
     return (here.st_dev, here.st_ino) == (there.st_dev, there.st_ino)
+
+
+def output_is_file(path: str) -> bool:
+    """Is output ``path`` a file written atomically (not stdout, a device or a pipe)? Then
+    work may keep a journal beside it."""
+    return path != "-" and not writes_stdout(path) and _target(path)[0] == "file"
 
 
 def check_output(path: str) -> None:

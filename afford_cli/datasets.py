@@ -11,7 +11,7 @@ from afford.artifacts import Artifact
 from afford.errors import AffordError
 from afford.features import OUTCOMES, FeatureSchema, Interactions
 
-__all__ = ["interactions_members", "interactions_from_artifact", "outcome_table", "behaviour_counts"]
+__all__ = ["interactions_members", "interactions_from_artifact", "outcome_table", "behaviour_counts", "check_shards"]
 
 _TRUTH = "truth_"
 
@@ -116,3 +116,41 @@ def _check_counts(art: Artifact, data: Interactions) -> None:
                               f"its arrays hold {value}")
     if "counts" in m and m["counts"] != behaviour_counts(data):
         raise AffordError(f"{art.source} is corrupt or was edited: its manifest's behaviour counts are not its arrays'")
+
+
+def check_shards(shards: list[tuple[Artifact, Interactions]]) -> tuple[list[int], tuple[int, int], int | None]:
+    """Shards of one exploration, checked: the order to join them in, the episodes they
+    cover together, and their seed. Each must have been explored by episodes (its manifest's
+    ``episodes``), all of one scene, schema and seed, with no episode twice and none missing."""
+    spans = []
+    for art, data in shards:
+        ep = art.manifest.get("episodes")
+        if not isinstance(ep, dict) or not {"start", "stop"} <= set(ep):
+            raise AffordError(f"{art.source} is no shard: it was not explored by episodes (explore shards with "
+                              "--episode-start and --episode-count)")
+        start, stop = int(ep["start"]), int(ep["stop"])
+        if len(data) and (data.episode.min() < start or data.episode.max() >= stop):
+            raise AffordError(f"{art.source} is corrupt or was edited: it holds episodes outside {start}-{stop - 1}")
+        spans.append((start, stop))
+    (first, a), m0 = shards[0], shards[0][0].manifest
+    for art, data in shards[1:]:
+        m = art.manifest
+        x, y = m0.get("scene", {}).get("name"), m.get("scene", {}).get("name")
+        if x != y:
+            raise AffordError(f"{first.source} and {art.source} are of different scenes ({x} and {y})")
+        if m0.get("scene") != m.get("scene"):
+            raise AffordError(f"{first.source} and {art.source} were explored with different scene settings")
+        if m0.get("seed") != m.get("seed"):
+            raise AffordError(f"{first.source} and {art.source} were explored with different seeds "
+                              f"({m0.get('seed')} and {m.get('seed')}), so they are not shards of one exploration")
+        if a.schema.to_json() != data.schema.to_json() or a.behaviors != data.behaviors:
+            raise AffordError(f"{first.source} and {art.source} perceive different features or have different behaviours")
+    order = sorted(range(len(shards)), key=lambda i: spans[i])
+    for i, j in zip(order, order[1:]):
+        (s0, e0), (s1, e1) = spans[i], spans[j]
+        if s1 < e0:
+            raise AffordError(f"{shards[i][0].source} and {shards[j][0].source} both hold episodes {s1}-{min(e0, e1) - 1}")
+        if s1 > e0:
+            raise AffordError(f"episodes {e0}-{s1 - 1} are in none of the shards: {shards[i][0].source} ends at "
+                              f"{e0 - 1}, {shards[j][0].source} starts at {s1}")
+    return order, (spans[order[0]][0], spans[order[-1]][1]), m0.get("seed")

@@ -47,16 +47,30 @@ class Output:
         self.err.print(message, soft_wrap=True)
 
     @contextmanager
-    def progress(self, description: str, total: int | None) -> Iterator[Callable[..., None]]:
+    def progress(self, description: str, total: int | None, lazy: bool = False) -> Iterator[Callable[..., None]]:
         """A rich progress bar on stderr; yields ``update(completed, total=None)`` (a total
-        given later, by the work itself, replaces an unknown one)."""
+        given later, by the work itself, replaces an unknown one). ``lazy``: the bar appears
+        at the first update, so checks that fail before any work leave stderr one sentence."""
         columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                    TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn())
         # with --json while stdout carries the artefact, stderr carries the JSON alone
-        with Progress(*columns, console=self.err, transient=False, disable=self.json_mode and self.stdout_busy) as bar:
-            task = bar.add_task(description, total=total)
-            yield lambda done, new_total=None: bar.update(task, completed=done, **(
-                {"total": new_total} if new_total is not None else {}))
+        bar = Progress(*columns, console=self.err, transient=False, disable=self.json_mode and self.stdout_busy)
+        task = None
+
+        def update(done, new_total=None):
+            nonlocal task
+            if task is None:
+                bar.start()
+                task = bar.add_task(description, total=total)
+            bar.update(task, completed=done, **({"total": new_total} if new_total is not None else {}))
+
+        if not lazy:
+            update(0)
+        try:
+            yield update
+        finally:
+            if task is not None:
+                bar.stop()
 
 
 def _jsonable(value: Any) -> Any:

@@ -24,7 +24,8 @@ import signal
 import sys
 
 from dataclasses import dataclass
-from typing import Callable, Iterator
+from contextlib import nullcontext
+from typing import Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -34,7 +35,7 @@ from afford.features.interactions import OUTCOMES
 from afford.sim.objects import SHAPES
 from afford.sim.world import ObjectTruth, TableWorld
 
-__all__ = ["explore", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
+__all__ = ["explore", "LocalPool", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
            "MOVED", "LIFTED"]
 
 #: A perceived position change above this (metres) counts as "the object moved".
@@ -232,15 +233,53 @@ def die_with_parent() -> None:
 _ASKED = False
 
 
-def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int | None, in_worker: bool = False) -> list[Interactions]:
+def _run_chunk(scene, seed: int, episodes: list[int], max_steps: int | None,
+               in_worker: bool = False) -> list[tuple[int, Interactions]]:
+    """Run some episodes (in a worker process, or here); returns ``(episode, rows)`` pairs."""
     if in_worker:
         die_with_parent()
-    return [run_episode(scene, seed, e, max_steps) for e in episodes]
+    return [(e, run_episode(scene, seed, e, max_steps)) for e in episodes]
 
 
-def _chunks(start: int, stop: int, size: int) -> Iterator[list[int]]:
-    for a in range(start, stop, size):
-        yield list(range(a, min(a + size, stop)))
+def _chunks(episodes: list[int], size: int) -> Iterator[list[int]]:
+    for a in range(0, len(episodes), size):
+        yield episodes[a:a + size]
+
+
+class LocalPool:
+    """Where episodes run on this machine: here (one worker) or on joblib's loky processes.
+
+    A pool runs tasks with :meth:`run` and yields each result as it finishes, in any order
+    (exploration puts episodes back in order itself). Other pools (afford's Dask pool) have
+    the same three members: ``workers``, ``in_processes`` and ``run``.
+    """
+
+    def __init__(self, workers: int = 1):
+        self.workers = workers
+        self.in_processes = workers > 1  # tasks run in worker processes this pool started
+        self._parallel = None
+
+    def __enter__(self) -> "LocalPool":
+        if self.workers > 1:
+            from joblib import Parallel
+
+            self._parallel = Parallel(n_jobs=self.workers, return_as="generator_unordered")
+            self._parallel.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._parallel is not None:
+            self._parallel.__exit__(*exc)
+            self._parallel = None
+
+    def run(self, fn: Callable, tasks: list[tuple]) -> Iterator:
+        if self._parallel is None:
+            for task in tasks:
+                yield fn(*task)
+            return
+        from joblib import delayed
+
+        yield from self._parallel(delayed(fn)(*task) for task in tasks)
 
 
 def explore(
@@ -252,47 +291,79 @@ def explore(
     workers: int = 1,
     max_steps: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-    chunk: int = 8,
+    chunk: int | None = None,
+    episode_start: int = 0,
+    done: Mapping[int, Interactions] | None = None,
+    on_done: Callable[[list[tuple[int, Interactions]]], None] | None = None,
+    pool=None,
 ) -> Interactions:
     """Run exploration episodes; stop after ``episodes`` or once ``interactions`` rows exist.
 
-    ``progress(done, total)`` is called as chunks finish (in episodes, or in rows when
-    ``interactions`` is given). With ``interactions`` the result is cut to exactly that
-    many rows, in episode order, so it too is the same for any number of workers.
+    Episodes ``episode_start`` .. ``episode_start + episodes - 1`` run (a shard of a larger
+    exploration when ``episode_start`` > 0); with ``interactions`` they run from episode 0
+    on until enough rows exist, and the result is cut to exactly that many rows in episode
+    order. Either way the rows are the same for any number of workers, any pool and any
+    order in which episodes finish.
+
+    ``done`` holds episodes already finished (a journal's, when a run resumes): they are not
+    run again. ``on_done(pairs)`` is called with each batch of newly finished ``(episode,
+    rows)`` pairs as it arrives, ``progress(done, total)`` after it (in episodes, or in rows
+    when ``interactions`` is given). ``pool`` runs the episodes (a :class:`LocalPool` of
+    ``workers`` by default); ``chunk`` episodes go to a task (8 at the table, 1 in scans).
     """
     if (episodes is None) == (interactions is None):
         raise DataError("give either episodes or interactions")
-    from joblib import Parallel, delayed
+    if interactions is not None and episode_start:
+        raise DataError("an exploration to a number of interactions starts at episode 0; shard one by episodes")
+    chunk = chunk or (1 if scene.loop == "scan" else 8)
+    first = episode_start
+    finished: dict[int, Interactions] = {}
+    last = first + episodes if episodes is not None else None
+    count = 0  # finished episodes of the range, or rows of finished episodes from ``first`` on
 
-    parts: list[Interactions] = []
-    total_rows = 0
-    next_episode = 0
+    def keep(pairs) -> None:
+        nonlocal count
+        for e, part in pairs:
+            if e in finished or e < first or (last is not None and e >= last):
+                continue
+            finished[e] = part
+            count += 1 if episodes is not None else len(part)
+
+    keep((done or {}).items())
+    own = pool is None
+    pool = LocalPool(workers) if own else pool
     target = episodes if episodes is not None else interactions
-    with Parallel(n_jobs=workers, return_as="generator") as parallel:
+    show = (lambda: progress(min(count, target), target)) if progress is not None else (lambda: None)
+    total_rows = 0
+    next_episode = first
+    with pool if own else nullcontext(pool):
+        show()
         while True:
             if episodes is not None:
-                if next_episode >= episodes:
+                if next_episode >= last:
                     break
-                stop = episodes
+                stop = last
             else:
                 if total_rows >= interactions:
                     break
                 # Ask for about as many episodes as the rows still missing need, at the rate
                 # seen so far (about two rows an episode at the table, every behaviour once
                 # in a scan), so little is explored in vain.
-                first_guess = len(scene.behaviors) if scene.loop == "scan" else 2.0  # a scan tries every behaviour
-                rate = total_rows / next_episode if next_episode else first_guess
-                need = max(workers * chunk, int((interactions - total_rows) / max(rate, 1.0)) + 1)
+                first_guess = len(scene.behaviors) if scene.loop == "scan" else 2.0
+                rate = total_rows / (next_episode - first) if next_episode > first else first_guess
+                need = max(pool.workers * chunk, int((interactions - total_rows) / max(rate, 1.0)) + 1)
                 stop = next_episode + need
-            jobs = (delayed(_run_chunk)(scene, seed, eps, max_steps, workers > 1) for eps in _chunks(next_episode, stop, chunk))
-            for result in parallel(jobs):
-                parts.extend(result)
-                total_rows += sum(len(r) for r in result)
-                if progress is not None:
-                    done = len(parts) if episodes is not None else min(total_rows, interactions)
-                    progress(done, target)
+            todo = [e for e in range(next_episode, stop) if e not in finished]
+            tasks = [(scene, seed, eps, max_steps, pool.in_processes) for eps in _chunks(todo, chunk)]
+            for result in pool.run(_run_chunk, tasks):
+                keep(result)
+                if on_done is not None:
+                    on_done(result)
+                show()
+            total_rows += sum(len(finished[e]) for e in range(next_episode, stop))
             next_episode = stop
-    data = Interactions.concatenate(parts)
+    data = Interactions.concatenate([finished[e] for e in range(first, next_episode)])
     if interactions is not None:
         data = data.subset(np.arange(interactions))
     return data
+

@@ -169,8 +169,9 @@ def test_sigterm_is_an_interruption_and_leaves_no_temp_file(tmp_path):
     proc, _ = _explore_until_workers(tmp_path)
     os.kill(proc.pid, signal.SIGTERM)
     _, err = proc.communicate(timeout=30)
-    assert proc.returncode == 130 and b"error: interrupted; the output being written was discarded" in err and b"Traceback" not in err
-    assert not list(tmp_path.iterdir())
+    assert proc.returncode == 130 and b"error: interrupted; " in err and b"Traceback" not in err
+    # no temporary file and no output; at most the journal of finished episodes (test_distributed.py)
+    assert [p.name for p in tmp_path.iterdir()] in ([], ["x.afford.partial"])
 
 
 # -- forged artefacts: checksums and seal recomputed, as a forger who knows the format would --

@@ -1,0 +1,214 @@
+"""Beyond one laptop (issue 15): the same bytes on loky, on Dask and after a resume; runs that
+survive SIGINT, SIGTERM and kill -9; shards merged into the one-shot run. Every cluster here
+binds 127.0.0.1 only and is torn down."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+import zipfile
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from afford.app import app
+
+AFFORD = [sys.executable, "-m", "afford"]
+EPISODES = ["--episodes", "60", "--seed", "5"]
+
+
+def run(args, cwd, **kw):
+    return subprocess.run([*AFFORD, *args], cwd=cwd, capture_output=True, text=True, **kw)
+
+
+def arrays(path: Path) -> dict[str, str]:
+    """The .npy members' checksums: what must be the same bytes."""
+    with zipfile.ZipFile(path) as z:
+        return {n: hashlib.sha256(z.read(n)).hexdigest() for n in z.namelist() if n.endswith(".npy")}
+
+
+@pytest.fixture(scope="module")
+def one_shot(tmp_path_factory):
+    """The reference: 60 table episodes of seed 5, on one worker, uninterrupted."""
+    d = tmp_path_factory.mktemp("oneshot")
+    r = run(["explore", *EPISODES, "-o", "one.afford"], d)
+    assert r.returncode == 0, r.stderr
+    assert not (d / "one.afford.partial").exists()  # the journal goes once the output is whole
+    return d / "one.afford"
+
+
+def _records(journal: Path) -> int:
+    from afford.journal import Journal
+
+    return Journal(journal, {})._count()
+
+
+def _start_and_wait(tmp_path: Path, out: str, episodes: int, at_least: int):
+    """Start an exploration and wait until its journal holds ``at_least`` episodes."""
+    proc = subprocess.Popen([*AFFORD, "explore", "--episodes", str(episodes), "--seed", "5", "-o", out],
+                            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 90
+    journal = tmp_path / (out + ".partial")
+    while time.time() < deadline:
+        if journal.is_dir() and _records(journal) >= at_least:
+            return proc, journal
+        if proc.poll() is not None:
+            pytest.fail(f"explore ended before its journal held {at_least} episodes: {proc.stderr.read()}")
+        time.sleep(0.05)
+    proc.kill()
+    pytest.fail("the journal did not grow")
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_an_interrupted_run_keeps_its_episodes_and_resumes_to_the_same_bytes(one_shot, tmp_path, sig):
+    proc, journal = _start_and_wait(tmp_path, "r.afford", 60, at_least=8)
+    os.kill(proc.pid, sig)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err
+    kept = _records(journal)
+    assert 8 <= kept < 60
+    assert f"{kept} finished episodes are kept in r.afford.partial" in err and "--resume" in err
+    assert not (tmp_path / "r.afford").exists()
+    # the same command without --resume refuses to start over the kept work
+    again = run(["explore", *EPISODES, "-o", "r.afford"], tmp_path)
+    assert again.returncode == 1 and "give --resume" in again.stderr and _records(journal) == kept
+    done = run(["explore", *EPISODES, "-o", "r.afford", "--resume", "--workers", "2"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert arrays(tmp_path / "r.afford") == arrays(one_shot)
+    assert not journal.exists()
+
+
+def test_kill_9_leaves_the_journal_readable_up_to_the_last_whole_episode(one_shot, tmp_path):
+    proc, journal = _start_and_wait(tmp_path, "k.afford", 60, at_least=5)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    kept = _records(journal)
+    assert kept >= 5
+    log = journal / "episodes.log"
+    whole = log.read_bytes()
+    # a record a killed writer had only begun: a header promising more bytes than follow
+    with open(log, "ab") as f:
+        f.write(whole[:40])
+    assert _records(journal) == kept
+    done = run(["explore", *EPISODES, "-o", "k.afford", "--resume"], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert arrays(tmp_path / "k.afford") == arrays(one_shot)
+
+
+def test_a_journal_of_another_run_is_refused_and_kept(tmp_path):
+    import afford
+    from afford.errors import Interrupted
+
+    def stop_after_3(done, total):
+        if done >= 3:
+            raise KeyboardInterrupt
+
+    journal = tmp_path / "j.afford.partial"
+    with pytest.raises(Interrupted, match="8 finished episodes are kept"):  # a task is 8 episodes
+        afford.explore("table", episodes=60, seed=5, journal=journal, progress=stop_after_3)
+    before = (journal / "episodes.log").read_bytes()
+    runner = CliRunner()
+    for args, why in ((["--seed", "6", "--episodes", "60"], "its seed is 5, this run's 6"),
+                      (["--seed", "5", "--episodes", "80"], "its episodes is 60, this run's 80"),
+                      (["--seed", "5", "--episodes", "60", "--size-max", "0.2"], "its scene settings differ")):
+        r = runner.invoke(app, ["explore", *args, "-o", str(tmp_path / "j.afford"), "--resume"])
+        assert r.exit_code == 1 and why in r.output and r.output.count("\n") == 1, r.output
+    assert (journal / "episodes.log").read_bytes() == before
+    assert not (tmp_path / "j.afford").exists()
+
+
+def test_shards_merge_into_the_one_shot_run_and_bad_shards_are_refused(one_shot, tmp_path):
+    runner = CliRunner()
+
+    def explore(name, *args):
+        r = runner.invoke(app, ["explore", "--seed", "5", *args, "-o", str(tmp_path / name)])
+        assert r.exit_code == 0, r.output
+
+    explore("a.afford", "--episode-start", "0", "--episode-count", "25")
+    explore("b.afford", "--episode-start", "25", "--episode-count", "35", "--workers", "2")
+    r = runner.invoke(app, ["merge", str(tmp_path / "b.afford"), str(tmp_path / "a.afford"), "-o", str(tmp_path / "m.afford")])
+    assert r.exit_code == 0, r.output
+    assert arrays(tmp_path / "m.afford") == arrays(one_shot)
+    # merged shards are a shard themselves: the merged file merges on
+    explore("c.afford", "--episode-start", "60", "--episode-count", "5")
+    r = runner.invoke(app, ["merge", str(tmp_path / "m.afford"), str(tmp_path / "c.afford"), "-o", str(tmp_path / "m2.afford"), "--json"])
+    assert r.exit_code == 0 and '"episodes": [\n  0,\n  65\n ]' in r.output
+
+    explore("over.afford", "--episode-start", "20", "--episode-count", "10")
+    explore("gap.afford", "--episode-start", "30", "--episode-count", "10")
+    explore("seed.afford", "--episode-start", "25", "--episode-count", "5", "--seed", "6")
+    explore("cut.afford", "--interactions", "30")
+    r = runner.invoke(app, ["explore", "--scene", "traverse-gaps", "--episode-start", "25", "--episode-count", "1",
+                            "-o", str(tmp_path / "gaps.afford")])
+    assert r.exit_code == 0, r.output
+    for shards, message in (
+            (["a.afford", "over.afford"], "both hold episodes 20-24"),
+            (["a.afford", "gap.afford"], "episodes 25-29 are in none of the shards"),
+            (["a.afford", "seed.afford"], "different seeds (5 and 6)"),
+            (["a.afford", "cut.afford"], "cut.afford is no shard"),
+            (["a.afford", "gaps.afford"], "different scenes (table and traverse-gaps)")):
+        r = runner.invoke(app, ["merge", *[str(tmp_path / s) for s in shards], "-o", str(tmp_path / "bad.afford")])
+        assert r.exit_code == 1 and message in r.output, (shards, r.output)
+        assert not (tmp_path / "bad.afford").exists()
+
+
+def test_shard_and_backend_options_are_checked(tmp_path):
+    runner = CliRunner()
+    out = str(tmp_path / "x.afford")
+    for args, message in ((["--episode-start", "5"], "--episode-count"),
+                          (["--episode-count", "5", "--interactions", "40"], "does not go with"),
+                          (["--scheduler", "tcp://127.0.0.1:1"], "needs --backend dask")):
+        r = runner.invoke(app, ["explore", *args, "-o", out])
+        assert r.exit_code == 2 and message in " ".join(r.output.replace("│", " ").split()), r.output
+    r = runner.invoke(app, ["explore", "--episodes", "3", "--resume", "-o", "-"])
+    assert r.exit_code == 1 and "--resume needs -o FILE" in r.output
+
+
+def test_without_the_dask_extra_the_backend_says_how_to_get_it(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed now fails
+    r = CliRunner().invoke(app, ["explore", "--episodes", "3", "--backend", "dask", "-o", str(tmp_path / "x.afford")])
+    assert r.exit_code == 1 and "pip install 'afford[dask]'" in r.output
+    assert not list(tmp_path.iterdir())
+
+
+def test_a_scheduler_that_does_not_answer_is_one_sentence(tmp_path):
+    r = run(["explore", "--episodes", "3", "--backend", "dask", "--scheduler", "tcp://127.0.0.1:1", "-o", "x.afford"],
+            tmp_path)
+    assert r.returncode == 1 and r.stderr.startswith("error: no Dask scheduler answers at tcp://127.0.0.1:1")
+    assert r.stderr.count("\n") == 1 and not list(tmp_path.iterdir())
+
+
+def test_dask_gives_the_same_bytes_on_its_own_cluster_and_on_a_running_one(one_shot, tmp_path):
+    from distributed import Client, LocalCluster
+
+    r = run(["explore", *EPISODES, "--backend", "dask", "--workers", "2", "-o", "own.afford"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert arrays(tmp_path / "own.afford") == arrays(one_shot)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address="127.0.0.1:0") as cluster, Client(cluster) as client:
+        addresses = [cluster.scheduler_address, *client.scheduler_info()["workers"]]
+        assert all(a.startswith("tcp://127.0.0.1:") for a in addresses), addresses
+        r = run(["explore", *EPISODES, "--backend", "dask", "--scheduler", cluster.scheduler_address,
+                 "-o", "theirs.afford"], tmp_path)
+        assert r.returncode == 0, r.stderr
+        assert len(client.scheduler_info()["workers"]) == 2  # the cluster is still there after
+    assert arrays(tmp_path / "theirs.afford") == arrays(one_shot)
+
+
+def test_traverse_scans_are_the_same_bytes_on_loky_and_dask():
+    import afford
+
+    def members(data):
+        from afford.datasets import interactions_members
+
+        return {k: v.tobytes() for k, v in interactions_members(data)[0].items()}
+
+    loky = afford.explore("traverse-gaps", episodes=4, seed=2, workers=2)
+    dask = afford.explore("traverse-gaps", episodes=4, seed=2, workers=2, backend="dask")
+    assert members(loky) == members(dask)
+    assert set(loky.episode.tolist()) == {0, 1, 2, 3}
