@@ -2,7 +2,9 @@
 
     python benchmarks/explore.py [--scenes table,traverse,...] [--interactions N] [--out benchmarks/results/explore.json]
 
-Prints one JSON object (and writes it to --out). The breakdown times one worker's
+Prints one JSON object (and writes it to --out). ``backends`` compares loky with Dask (a
+LocalCluster of 2 workers on 127.0.0.1: start-up, interactions/s, shut-down) and checks that
+both, and a run interrupted half-way and resumed, give the same bytes (2000 interactions). The breakdown times one worker's
 episodes in this process by wrapping each stage. The table: world build, ray casting
 (Open3D), physics (PhysX steps, including contact queries) and features (detection,
 normals, histograms, tracking). The traverse scenes: world build, the scan (720 x 720
@@ -44,6 +46,60 @@ def throughput(scene, n: int, workers: int, seed: int) -> dict:
     return {"workers": workers, "interactions": len(data), "environments": environments, "seconds": round(seconds, 3),
             "interactions_per_second": round(len(data) / seconds, 1),
             "environments_per_second": round(environments / seconds, 2)}
+
+
+def backends(scene, n: int, seed: int) -> dict:
+    """loky against Dask (a LocalCluster of 2 workers on 127.0.0.1), and a run interrupted
+    half-way and resumed from its journal: interactions/s, Dask's start-up and shut-down,
+    and whether all three gave the same bytes."""
+    import tempfile
+
+    import afford
+    from afford.backends import open_pool
+    from afford.datasets import interactions_members
+    from afford.errors import Interrupted
+
+    def digest(data) -> str:
+        import hashlib
+
+        h = hashlib.sha256()
+        for k, v in sorted(interactions_members(data)[0].items()):
+            h.update(k.encode() + v.tobytes())
+        return h.hexdigest()
+
+    out: dict = {"interactions": n}
+    start = time.perf_counter()
+    loky = afford.explore(scene, interactions=n, seed=seed, workers=2)
+    out["loky_2_workers"] = {"seconds": round(time.perf_counter() - start, 2),
+                             "interactions_per_second": round(n / (time.perf_counter() - start), 1)}
+    t0 = time.perf_counter()
+    with open_pool("dask", 2) as pool:
+        started = time.perf_counter() - t0
+        from afford.sim.explore import explore as run
+
+        run(scene, interactions=min(n, 200), seed=seed + 999, pool=pool)  # both workers import afford
+        t1 = time.perf_counter()
+        dask = run(scene, interactions=n, seed=seed, pool=pool)
+        seconds = time.perf_counter() - t1
+        t2 = time.perf_counter()
+    out["dask_2_workers"] = {"seconds": round(seconds, 2), "interactions_per_second": round(n / seconds, 1),
+                             "cluster_start_seconds": round(started, 2),
+                             "shutdown_seconds": round(time.perf_counter() - t2, 2)}
+    with tempfile.TemporaryDirectory() as d:
+        journal = Path(d) / "run.partial"
+
+        def stop_half_way(done, total):
+            if done >= total // 2:
+                raise KeyboardInterrupt
+
+        try:
+            afford.explore(scene, interactions=n, seed=seed, workers=2, journal=journal, progress=stop_half_way)
+        except Interrupted:
+            pass
+        resumed = afford.explore(scene, interactions=n, seed=seed, workers=2, journal=journal, resume=True)
+    out["same_bytes"] = {"loky": digest(loky), "dask": digest(dask) == digest(loky),
+                         "interrupted_and_resumed": digest(resumed) == digest(loky)}
+    return out
 
 
 def _patched(targets: list[tuple[object, str, str]], totals: dict):
@@ -116,6 +172,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--interactions", type=int, default=1000, help="per throughput run on the table")
     ap.add_argument("--traverse-interactions", type=int, default=700, help="per throughput run on a traverse scene")
+    ap.add_argument("--backend-interactions", type=int, default=2000, help="per run comparing loky, Dask and a resume")
     ap.add_argument("--scenes", default="table,traverse,traverse-body,traverse-ramps,traverse-gaps")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "explore.json"))
@@ -142,6 +199,7 @@ def main() -> None:
         "throughput": [throughput(scene, args.interactions, w, args.seed) for w in (1, 2)],
         "breakdown_one_worker": breakdown(scene, episodes=max(20, args.interactions // 10), seed=args.seed),
         "features_alone_ms": None,
+        "backends": backends(scene, args.backend_interactions, args.seed),
     })
     # perception alone, on a typical range image
     rng = np.random.default_rng(0)

@@ -212,3 +212,22 @@ def test_traverse_scans_are_the_same_bytes_on_loky_and_dask():
     dask = afford.explore("traverse-gaps", episodes=4, seed=2, workers=2, backend="dask")
     assert members(loky) == members(dask)
     assert set(loky.episode.tolist()) == {0, 1, 2, 3}
+
+
+def test_a_run_to_a_number_of_interactions_resumes_to_the_same_rows(tmp_path):
+    import afford
+    from afford.datasets import interactions_members
+    from afford.errors import Interrupted
+
+    def stop_at_60(done, total):
+        if done >= 60:
+            raise KeyboardInterrupt
+
+    journal = tmp_path / "i.partial"
+    with pytest.raises(Interrupted):
+        afford.explore("table", interactions=150, seed=8, workers=2, journal=journal, progress=stop_at_60)
+    resumed = afford.explore("table", interactions=150, seed=8, journal=journal, resume=True)
+    one = afford.explore("table", interactions=150, seed=8)
+    assert len(resumed) == 150
+    a, b = interactions_members(one)[0], interactions_members(resumed)[0]
+    assert a.keys() == b.keys() and all(a[k].tobytes() == b[k].tobytes() for k in a)

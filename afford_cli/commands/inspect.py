@@ -61,6 +61,7 @@ def describe(art: Artifact) -> dict:
         info.update({
             "n_interactions": m["n_interactions"],
             "n_episodes": m.get("n_episodes"),
+            "episode_range": [m["episodes"]["start"], m["episodes"]["stop"]] if isinstance(m.get("episodes"), dict) else None,
             "counts": behaviour_counts(data),
             "outcomes": outcome_table(data),
             "scene": m.get("scene", {}),
@@ -79,7 +80,9 @@ def render(console, info: dict) -> None:
     head.add_row("checksums", "verified" if info["sealed"] else
                  "members verified; the manifest is unsealed (schema 1), so an edit to it would not show")
     if "n_interactions" in info:
-        head.add_row("interactions", f"{info['n_interactions']} in {info['n_episodes']} episodes")
+        span = info.get("episode_range")
+        head.add_row("interactions", f"{info['n_interactions']} in {info['n_episodes']} episodes" + (
+            f" (episodes {span[0]}-{span[1] - 1}: a shard 'afford merge' can join)" if span else ""))
         head.add_row("scene", str(info["scene"].get("name", "?")))
     console.print(head)
     if info["features"]:
