@@ -432,10 +432,11 @@ class Model(LoadedModel):
         return self.plans(state, goal, **limits)[0]
 
     def execute(self, world, goal, *, first=None, alternatives: int = 3, max_replans: int = 3,
-                method: str = "best-first", max_depth: int = 5, max_nodes: int = 20000):
+                method: str = "best-first", max_depth: int = 5, max_nodes: int = 20000, say=None):
         """Plan in ``world`` (see :func:`world`; ``first``: a plan already made there), act,
         compare each step with its prediction, and replan on a surprise (each replan chosen
-        among ``alternatives`` the same way): the :class:`afford.plan.monitor.Execution`."""
+        among ``alternatives`` the same way): the :class:`afford.plan.monitor.Execution`.
+        ``say(line)`` hears each step, its outcome and each replan as they happen."""
         from afford.plan.monitor import execute as run
         from afford.plan.monitor import ranked_planner
 
@@ -447,7 +448,7 @@ class Model(LoadedModel):
         goal = parse_goal(goal, self.schema)
         planner = ranked_planner(self.forward(), goal, alternatives, max_replans=max_replans, method=method, **limits)
         return run(world, self.forward(), goal, method=method, max_replans=max_replans, first=first,
-                   planner=planner, **limits)
+                   planner=planner, say=say, **limits)
 
     def inverse(self, state: np.ndarray, want) -> list[dict]:
         """Inverse query: (object, behaviour, alpha) ranked by the probability that one step

@@ -44,7 +44,7 @@ class Output:
         self.err.print(f"[yellow]warning:[/] {message}")
 
     def info(self, message: str) -> None:
-        self.err.print(message, soft_wrap=True)
+        self.err.print(message, soft_wrap=True, markup=False, highlight=False)
 
     @contextmanager
     def progress(self, description: str, total: int | None, lazy: bool = False) -> Iterator[Callable[..., None]]:

@@ -8,16 +8,19 @@ __all__ = ["plan_once"]
 
 
 def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int,
-              alternatives: int = 3) -> dict:
+              alternatives: int = 3, say=None) -> dict:
     """Plan in one scene (and execute with monitoring); the result as plain data.
 
     With ``alternatives`` > 1 the most probable plans are ranked by their success
     probability with monitoring, the first is the plan (and every replan is chosen the same
-    way), and the others are reported under ``alternatives``.
+    way), and the others are reported under ``alternatives``. ``say(line)`` hears the
+    search start and, when executing, each step and replan as it happens.
     """
     world = open_world(scene, specs, seed)
     start = world.perceive()
     model.check_schema(scene.schema, "this scene's perception")
+    if say is not None:
+        say(f"searching for a plan ({alternatives} candidate{'s' * (alternatives != 1)}, ranked by success probability)")
     ranked = model.plans(start, goal, alternatives=alternatives, max_replans=max_replans, method=method, **limits)
     first = ranked[0]
     out = {"seed": seed, "objects": start.shape[0], "plan": first.to_json(), "tree": first.tree[:12]}
@@ -25,7 +28,7 @@ def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, e
         out["alternatives"] = [p.to_json() for p in ranked[1:]]
     if execute and first.found:
         result = model.execute(world, goal, first=first, alternatives=alternatives, max_replans=max_replans,
-                               method=method, **limits)
+                               method=method, say=say, **limits)
         out["execution"] = result.to_json()
         out["reached"] = result.reached
         out["replans"] = result.replans

@@ -98,19 +98,23 @@ def mismatch(goal: Goal, predicted: np.ndarray, perceived: np.ndarray, schema, s
 
 def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "best-first", max_replans: int = 3,
             first: Plan | None = None, planner: Callable[[np.ndarray, tuple, int], Plan] | None = None,
-            **limits) -> Execution:
+            say: Callable[[str], None] | None = None, **limits) -> Execution:
     """Plan (unless ``first`` is given), execute step by step, replan on surprises.
 
     ``planner(state, avoid, held)`` replaces the search (with ``method`` and ``limits``)
     where given. The robot keeps track of what its hand holds (an object a step raised) and
-    replans with it.
+    replans with it. ``say(line)``, if given, hears what is going on: each step as it starts
+    and how it went, each replan as its search starts.
     """
+    say = say or (lambda line: None)
     if planner is None:
         def planner(state: np.ndarray, avoid: tuple, held: int) -> Plan:
             return search(model, state, goal, method, avoid=avoid, held=held, **limits)
 
     state = world.perceive()
     held = -1
+    if first is None:
+        say("searching for a plan")
     plan = first if first is not None else planner(state, (), held)
     run = Execution(False, [plan])
     # (object seen before, behaviour, object, whether the hand held it) of steps that surprised
@@ -125,9 +129,12 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             run.reason = "goal reached"
             return run
         surprised, windfall = "", False
-        for step in plan.steps:
+        for k, step in enumerate(plan.steps, 1):
             previous, was_held = state, held == step.obj
             before = situation(model, state, step.obj)
+            on = "the scene" if step.obj == SCENE else f"object {step.obj}"
+            say(f"executing step {k} of {len(plan.steps)}{f' (plan {len(run.plans)})' if len(run.plans) > 1 else ''}: "
+                f"{step.behavior} on {on}")
             state = world.act(step.behavior, step.obj, np.asarray(step.alpha, dtype=float))
             held = step.obj if model.in_hand(previous, state, step.obj) else -1
             if not getattr(world, "last_executed", True):
@@ -140,16 +147,19 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
                 if surprised:
                     failed.append((before, step.behavior, step.obj, was_held))
             run.executed.append({**step.to_json(), "as_predicted": not surprised, "note": surprised})
+            say(f"  step {k}: {'as predicted' if not surprised else 'surprise: ' + surprised}")
             if goal.holds(state):
                 run.reached = True
                 run.reason = "goal reached"
+                say("goal reached")
                 return run
             if surprised:
                 windfall = goal.distance(state) < goal.distance(step.predicted) - 1e-9
                 break
         if not surprised:  # every step went as predicted, yet the goal does not hold
             surprised = "the plan ran as predicted but the goal does not hold"
-        if windfall and run.windfalls < max_replans:
+        helped = windfall and run.windfalls < max_replans
+        if helped:
             # The world went the goal's way further than predicted (another object fell
             # too): a new plan is needed, but the model did not let the robot down.
             run.windfalls += 1
@@ -160,6 +170,8 @@ def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "bes
             run.replans += 1
         # Behaviours that surprised the robot cost more in the new search: the model would
         # predict the same again, and the robot go round in circles.
+        say(f"replanning ({'the surprise helped: no replan counted' if helped else f'replan {run.replans} of at most {max_replans}'}): "
+            f"{surprised}")
         plan = planner(state, tuple(failed), held)
         run.plans.append(plan)
 

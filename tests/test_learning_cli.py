@@ -180,6 +180,20 @@ def test_plan_and_execute_in_simulation(pipeline):
         assert out["execution"]["executed"]
 
 
+def test_plan_execute_shows_each_step_on_stderr_and_keeps_stdout_json(pipeline):
+    result = ok(["plan", str(pipeline / "model.afford"), "--seed", "3", "--reachable", "--goal", "*:visibility=0",
+                 "--execute", "--json"])
+    out = json.loads(result.stdout)
+    lines = result.stderr.splitlines()
+    assert lines[0].startswith("searching for a plan (3 candidates")
+    executed = out["execution"]["executed"]
+    starts = [ln for ln in lines if ln.startswith("executing step ")]
+    assert len(starts) == len(executed) >= 1
+    assert starts[0].endswith(f"{executed[0]['behavior']} on object {executed[0]['object']}")
+    assert sum(ln.startswith("replanning") for ln in lines) == out["replans"] + out["execution"]["windfalls"]
+    assert (lines[-1] == "goal reached") == out["reached"]
+
+
 def test_plan_ranks_alternatives_by_success_probability(pipeline):
     args = ["plan", str(pipeline / "model.afford"), "--seed", "3", "--reachable", "--goal", "*:visibility=0", "--json"]
     one = json.loads(ok(args + ["--alternatives", "1"]).stdout)

@@ -169,6 +169,19 @@ def test_monitoring_replans_when_a_step_surprises():
     assert [s["as_predicted"] for s in run.executed] == [False, True, True]
 
 
+def test_monitoring_says_each_step_and_replan_as_it_happens():
+    fm = ForwardModel([PUSH], SCHEMA)
+    world = ScriptedWorld(scene(0.0), {"push": [effect(), effect(0.2), effect(0.2)]})  # the first push misses
+    lines = []
+    run = execute(world, fm, goal("0:x_min=0.4~0.01"), max_replans=3, say=lines.append)
+    assert run.reached
+    assert lines[0] == "searching for a plan" and lines[-1] == "goal reached"
+    assert lines[1] == "executing step 1 of 2: push on object 0"
+    assert lines[2].startswith("  step 1: surprise: object 0 ended")
+    assert lines[3].startswith("replanning (replan 1 of at most 3): object 0 ended")
+    assert lines[4] == "executing step 1 of 2 (plan 2): push on object 0" and lines[5] == "  step 1: as predicted"
+
+
 def test_monitoring_stops_repeating_what_fails_and_tries_something_else():
     fm = ForwardModel([SWEEP, THROW], SCHEMA)
     world = ScriptedWorld(scene(0.0), {"sweep": [effect()], "throw": [effect(vanish=True)]})

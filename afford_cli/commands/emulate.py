@@ -44,6 +44,9 @@ def emulate(
     except DataError as exc:
         raise AffordError(str(exc)) from None
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}
+    out = Output(json)
+    if execute:
+        out.info(f"derived goal: {' and '.join(goal.to_json())}; searching for a plan")
     ranked = loaded.plans(state, goal, alternatives=alternatives, max_replans=max_replans, **limits)
     plan = ranked[0]
     result = {"goal": goal.to_json(), "plan": plan.to_json()["steps"], "found": plan.found,
@@ -55,7 +58,8 @@ def emulate(
     if alternatives > 1:
         result["alternatives"] = entry["alternatives"] = [p.to_json() for p in ranked[1:]]
     if execute and plan.found:
-        ex = loaded.execute(world, goal, first=plan, alternatives=alternatives, max_replans=max_replans, **limits)
+        ex = loaded.execute(world, goal, first=plan, alternatives=alternatives, max_replans=max_replans,
+                            say=out.info, **limits)
         result.update({"reached": ex.reached, "replans": ex.replans, "execution": ex.to_json()})
         entry["execution"] = ex.to_json()
     elif not plan.found:
@@ -65,4 +69,4 @@ def emulate(
         console.print(f"shown: {len(shown)} object(s); derived goal: {' and '.join(goal.to_json())}")
         render_plan(console, entry, goal.to_json())
 
-    Output(json).result(result, render)
+    out.result(result, render)

@@ -95,7 +95,8 @@ def plan(
     loaded.check_schema(make_scene(scene).schema, "this scene's perception")
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable)
-        entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives))
+        entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives,
+                                 say=out.info if execute else None))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
