@@ -4,17 +4,18 @@ from __future__ import annotations
 
 from afford.scenes_io import open_world
 
-__all__ = ["plan_once"]
+__all__ = ["plan_once", "draw_plan"]
 
 
 def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int,
-              alternatives: int = 3, say=None) -> dict:
+              alternatives: int = 3, say=None, plot: str | None = None) -> dict:
     """Plan in one scene (and execute with monitoring); the result as plain data.
 
     With ``alternatives`` > 1 the most probable plans are ranked by their success
     probability with monitoring, the first is the plan (and every replan is chosen the same
     way), and the others are reported under ``alternatives``. ``say(line)`` hears the
-    search start and, when executing, each step and replan as it happens.
+    search start and, when executing, each step and replan as it happens. ``plot``: a PNG
+    of the start's range image and the scene from above (:func:`draw_plan`).
     """
     world = open_world(scene, specs, seed)
     start = world.perceive()
@@ -34,4 +35,19 @@ def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, e
         out["replans"] = result.replans
         # did the first plan, as planned, work without replanning?
         out["first_plan_worked"] = result.reached and result.replans == 0 and result.windfalls == 0
+    if plot is not None:
+        reached = f"; reached: {'yes' if out['reached'] else 'no'}" if "reached" in out else ""
+        out["plot"] = draw_plan(plot, model.schema, world, start, first, world.perceive() if "execution" in out else None,
+                                f"plan for {' and '.join(goal.to_json())}{reached}")
     return out
+
+
+def draw_plan(path: str, schema, world, start, plan, actual=None, title: str = "", shown=None) -> str:
+    """The start's range image, and the scene from above: where each object started, where
+    the plan's last step is predicted to leave it, and (executed) where it really ended."""
+    from afford.plots import scene_figure
+
+    predicted = plan.steps[-1].predicted if plan.found and plan.steps else None
+    steps = ", ".join(f"{s.behavior} {s.obj}" for s in plan.steps) if plan.found else "no plan found"
+    panel = {"title": f"from above: {steps}", "start": start, "predicted": predicted, "actual": actual, "shown": shown}
+    return scene_figure(path, schema, view=getattr(world, "start_view", None), panels=[panel], title=title)

@@ -29,11 +29,18 @@ from afford.errors import AffordError
 __all__ = [
     "PlotDir", "plot_directory", "written", "artefact_plots", "evaluation_plots",
     "prototypes_figure", "relevance_figure", "outcomes_figure", "confusion_figure", "reliability_figure",
+    "scene_figure", "check_plot_file", "PlotFile",
 ]
 
 #: ``--plots DIR``, shared by inspect and evaluate.
 PlotDir = Annotated[Optional[Path], typer.Option(
     "--plots", metavar="DIR", help="Also write PNG figures into DIR (created if missing).")]
+
+#: ``--plot FILE.png``, shared by predict, plan and emulate.
+PlotFile = Annotated[Optional[str], typer.Option(
+    "--plot", metavar="FILE.png", help="Also draw what the robot saw (the range image, objects outlined and numbered) "
+                                       "and the scene from above: where each object started, was predicted to end and "
+                                       "(with --check/--execute) really ended.")]
 
 DPI = 100
 TOP_FEATURES = 20
@@ -82,11 +89,26 @@ def _new_figure(width: float, height: float, **kwargs):
 
 
 def _save(fig, path: Path) -> str:
-    try:
-        fig.savefig(path, dpi=DPI, format="png")
-    except OSError as exc:
-        raise AffordError(f"cannot write the plot {path} ({exc.strerror or exc})") from None
+    """Write the figure as PNG, atomically (a temporary file beside it, renamed into place)."""
+    import io
+
+    from afford.artifacts import write_artifact
+
+    buf = io.BytesIO()
+    fig.savefig(buf, dpi=DPI, format="png")
+    write_artifact(str(path), buf.getvalue())
     return str(path)
+
+
+def check_plot_file(path: str | None) -> None:
+    """Fail before any work if ``--plot FILE`` cannot take a PNG."""
+    from afford.artifacts import check_output
+
+    if path is None:
+        return
+    if path == "-" or not path.lower().endswith(".png"):
+        raise AffordError(f"--plot takes a file name ending in .png, not {path!r}")
+    check_output(path)
 
 
 # --------------------------------------------------------------------------- what a command draws
@@ -351,4 +373,136 @@ def reliability_figure(path: Path, behavior: str, metrics: dict, n_bins: int = 1
     head = f"ECE {ece:.3f}, " if ece is not None else ""
     top.set_title(f"{behavior}: reliability of the predicted probabilities\n{head}{n} held-out interactions",
                   fontsize=10)
+    return _save(fig, path)
+
+
+# --------------------------------------------------------------------------- what the robot saw and did
+
+_OBJECT_COLOURS = ("#2f78c4", "#d9822b", "#2e8b3d", "#8e5ab5", "#c8372d", "#6b7b8c")
+
+
+def _footprint_columns(schema) -> tuple[int, int, int, int] | None:
+    names = ("x_min", "x_max", "y_min", "y_max")
+    if not all(n in schema.names for n in names):
+        return None
+    return tuple(schema.index(n) for n in names)  # type: ignore[return-value]
+
+
+def scene_figure(path: Path, schema, *, view=None, panels=(), results=None, title: str = "") -> str:
+    """What the robot saw, and what it expected and got, in one PNG.
+
+    ``view``: ``(ranges, boxes)`` of the start (a scene world's ``last_view``): the range
+    image, each detected object outlined and numbered. ``panels``: top views of the scene in
+    the robot's frame (metres), each ``{"title", "start", "predicted", "actual", "shown"}``
+    with (k, d) entity arrays (any but ``start`` may be None): every object's footprint
+    where it started (solid), where the model predicted it would end (dashed), where it
+    really ended (filled), and where a shown scene has its objects (dotted). An object that
+    vanished is a cross at its last seen place. ``results``: for a model of given results
+    (chapter 5), ``[(behaviour, P(success), observed result or None)]`` as bars.
+    """
+    import numpy as np
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch, Rectangle
+
+    cols = _footprint_columns(schema)
+    tops = list(panels) if cols is not None else []
+    n = (view is not None) + len(tops) + (results is not None)
+    if n == 0:
+        raise AffordError("there is nothing to draw for this scene")
+    per_row = min(n, 3)
+    rows = -(-n // per_row)
+    fig = _new_figure(5.6 * per_row, 4.2 * rows + (0.6 if title else 0))
+    axes = list(np.atleast_1d(fig.subplots(rows, per_row)).ravel())
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    k = 0
+    if view is not None:
+        ranges, boxes = view
+        ax = axes[k]
+        k += 1
+        shown = np.where(np.isfinite(ranges), ranges, np.nan)
+        image = ax.imshow(shown, cmap="viridis_r", interpolation="nearest")
+        bar = fig.colorbar(image, ax=ax, shrink=0.8)
+        bar.set_label("range (m); blank: nothing hit", fontsize=8)
+        for i, (r0, c0, r1, c1) in enumerate(boxes):
+            colour = _OBJECT_COLOURS[i % len(_OBJECT_COLOURS)]
+            ax.add_patch(Rectangle((c0 - 0.5, r0 - 0.5), c1 - c0, r1 - r0, fill=False, lw=1.8, ec=colour))
+            ax.text(c0, r0 - 1.5, str(i), color=colour, fontsize=10, fontweight="bold", va="bottom")
+        ax.set_xlabel("image column (ray)", fontsize=9)
+        ax.set_ylabel("image row (ray)", fontsize=9)
+        ax.set_title(f"range image at the start: {len(boxes)} object{'s' * (len(boxes) != 1)} detected"
+                     if boxes or cols is not None else "range image at the start", fontsize=10)
+    vis = schema.visibility_index
+    for panel in tops:
+        ax = axes[k]
+        k += 1
+        x0, x1, y0, y1 = cols
+        extent = []
+
+        def draw(f, colour, style, label_number=None):
+            seen = vis is None or f[vis] >= 0.5
+            cx, cy = (f[x0] + f[x1]) / 2, (f[y0] + f[y1]) / 2
+            extent.append((f[x0], f[x1], f[y0], f[y1]))
+            if not seen:  # predicted to vanish: a thin cross; vanished: a bold one
+                if style == "actual":
+                    ax.plot([cx], [cy], marker="X", ms=12, color=colour, alpha=0.6, ls="")
+                else:
+                    ax.plot([cx], [cy], marker="x", ms=10, mew=1.6, color=colour, ls="")
+            elif style == "actual":
+                ax.add_patch(Rectangle((f[x0], f[y0]), f[x1] - f[x0], f[y1] - f[y0], fc=colour, ec=colour, alpha=0.3))
+            else:
+                ax.add_patch(Rectangle((f[x0], f[y0]), f[x1] - f[x0], f[y1] - f[y0], fill=False, ec=colour,
+                                       lw={"start": 1.8, "predicted": 1.6, "shown": 1.4}[style],
+                                       ls={"start": "-", "predicted": "--", "shown": ":"}[style]))
+            if label_number is not None:
+                ax.text(cx, cy, str(label_number), color=colour, fontsize=10, fontweight="bold", ha="center", va="center")
+
+        start = np.asarray(panel["start"])
+        for i, f in enumerate(start):
+            colour = _OBJECT_COLOURS[i % len(_OBJECT_COLOURS)]
+            draw(f, colour, "start", i)
+            for key in ("predicted", "actual"):
+                if panel.get(key) is not None and i < len(panel[key]):
+                    draw(np.asarray(panel[key])[i], colour, key)
+        for f in (panel.get("shown") if panel.get("shown") is not None else []):
+            draw(np.asarray(f), "#1a1a1a", "shown")
+        if extent:
+            e = np.asarray(extent)
+            pad = 0.08
+            ax.set_xlim(e[:, 0].min() - pad, e[:, 1].max() + pad)
+            ax.set_ylim(e[:, 2].min() - pad, e[:, 3].max() + pad)
+        ax.set_aspect("equal", adjustable="box")
+        ax.grid(alpha=0.3)
+        ax.set_xlabel("x, ahead of the robot (m)", fontsize=9)
+        ax.set_ylabel("y, to its left (m)", fontsize=9)
+        ax.set_title(panel.get("title", ""), fontsize=10)
+        handles = [Line2D([], [], color="#444", lw=1.8, label="start (numbered)")]
+        if panel.get("predicted") is not None:
+            handles.append(Line2D([], [], color="#444", lw=1.6, ls="--", label="predicted end"))
+        if panel.get("actual") is not None:
+            handles.append(Patch(fc="#444", alpha=0.3, label="actual end"))
+        if panel.get("shown") is not None:
+            handles.append(Line2D([], [], color="#1a1a1a", lw=1.4, ls=":", label="shown (the goal)"))
+        if panel.get("predicted") is not None:
+            handles.append(Line2D([], [], color="#444", marker="x", ls="", ms=8, label="predicted to vanish"))
+        if panel.get("actual") is not None:
+            handles.append(Line2D([], [], color="#444", marker="X", ls="", ms=8, alpha=0.6, label="vanished"))
+        ax.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    if results is not None:
+        ax = axes[k]
+        names = [r[0] for r in results]
+        p = [r[1] for r in results]
+        ax.barh(range(len(names)), p, color=_SELECTED)
+        for i, (_, q, seen) in enumerate(results):
+            ax.text(min(q, 0.98), i, f" {q:.2f}" + (f"  (ran: {seen})" if seen is not None else ""), va="center",
+                    fontsize=8, ha="right" if q > 0.6 else "left")
+        ax.set_yticks(range(len(names)), names, fontsize=8)
+        ax.set_xlim(0, 1)
+        ax.invert_yaxis()
+        ax.set_xlabel("predicted probability of success", fontsize=9)
+        ax.set_title("what each behaviour would do", fontsize=10)
+    if title:
+        import textwrap
+
+        fig.suptitle(textwrap.fill(title, 60 * per_row), fontsize=10)
     return _save(fig, path)

@@ -67,7 +67,14 @@ class ScanningWorld:
 
     def perceive(self) -> np.ndarray:
         """The environment as one entity: (1, d) grid features of a fresh scan."""
-        return grid_features(self.world.scan(), self.grid).astype(np.float64)[None, :]
+        self.last_image = self.world.scan()
+        return grid_features(self.last_image, self.grid).astype(np.float64)[None, :]
+
+    def last_view(self) -> tuple[np.ndarray, list] | None:
+        """The last scan's ranges (rows, cols; inf where nothing was hit), and no object boxes:
+        this robot perceives the whole environment, not objects."""
+        image = getattr(self, "last_image", None)
+        return None if image is None else (np.asarray(image.ranges), [])
 
     def move(self, rotate: float, drive: float):
         self.odometry = self.world.move(rotate, drive)

@@ -42,6 +42,10 @@ class SimWorld:
         self.world = scene.build(self.layout, self.rng)
         self._behaviors = {b.name: b for b in scene.behaviors}
         self.state = np.asarray(self.world.perceive())
+        view = getattr(self.world, "last_view", None)
+        #: What the robot saw at the start (see ``last_view`` of the scene's world): the range
+        #: image and each object's pixel box, numbered as the objects are; None if unknown.
+        self.start_view = view() if view is not None else None
         self.history: list[Step | Trial] = []
 
     @property

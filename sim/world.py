@@ -15,6 +15,7 @@ import numpy as np
 import sapien
 
 from afford.features import RegionOfInterest, perceive, track
+from afford.features.detect import detect_objects
 from afford.features.errors import DataError
 from afford.features.objects import N_OBJECT_FEATURES
 from afford.features.objects import centres as object_centres
@@ -185,7 +186,21 @@ class TableWorld:
     def look(self) -> np.ndarray:
         """Detect the objects in view now: (k, 43) feature vectors."""
         image = self.camera.capture(self.meshes(), self.rng)
+        self.last_image = image
         return perceive(image, self.config.roi())
+
+    def last_view(self) -> tuple[np.ndarray, list[tuple[int, int, int, int]]] | None:
+        """The last range image (H, W; inf where nothing was hit) and each detected object's
+        pixel box (row0, col0, row1, col1), in the order of the look's feature rows; None
+        before the first look. For pictures: detection runs again on the same image."""
+        image = getattr(self, "last_image", None)
+        if image is None:
+            return None
+        boxes = []
+        for d in detect_objects(image, self.config.roi()):
+            (r, c), (h, w) = d.origin, d.mask.shape
+            boxes.append((int(r), int(c), int(r + h), int(c + w)))
+        return np.asarray(image.ranges), boxes
 
     def perceive(self) -> np.ndarray:
         """Perceive and keep track of the objects first seen (vanished ones: visibility 0)."""

@@ -154,3 +154,58 @@ def test_reliability_bins_by_hand():
 def test_commands_that_do_not_plot_do_not_import_matplotlib():
     code = "import sys, afford.app; sys.exit('matplotlib' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+# -- what the robot saw and did: --plot FILE.png on predict, plan and emulate ----------------
+
+def _png_size(path) -> tuple[int, int]:
+    from matplotlib.image import imread
+
+    image = imread(path)
+    return image.shape[1], image.shape[0]
+
+
+def test_predict_plan_and_emulate_draw_what_the_robot_saw(pipeline, tmp_path):
+    model = str(pipeline / "model.afford")
+    layouts = __import__("pathlib").Path(__file__).resolve().parents[1] / "examples" / "layouts"
+    runs = {
+        "predict.png": ["predict", model, "--seed", "5", "--objects", "2", "--check"],
+        "plan.png": ["plan", model, "--seed", "3", "--reachable", "--goal", "*:visibility=0", "--execute"],
+        "emulate.png": ["emulate", model, "--observe", str(layouts / "close-shown.toml"),
+                        "--start", str(layouts / "close-start-1.toml")],
+    }
+    for name, args in runs.items():
+        result = runner.invoke(app, [*args, "--plot", str(tmp_path / name), "--json"])
+        assert result.exit_code == 0, result.output
+        assert json.loads(result.stdout)["plot"] == str(tmp_path / name)
+        assert is_png(tmp_path / name) and (tmp_path / name).stat().st_size > 20_000
+        width, height = _png_size(tmp_path / name)
+        assert width >= 800 and height >= 400, (name, width, height)
+    # predict draws the range image and one top view per behaviour: two rows of three panels
+    assert _png_size(tmp_path / "predict.png")[1] > _png_size(tmp_path / "plan.png")[1]
+
+
+def test_the_start_view_outlines_each_object_the_robot_tracks(pipeline):
+    import afford
+
+    world = afford.world("table", seed=5, objects=3)
+    ranges, boxes = world.start_view
+    state = world.perceive()
+    assert ranges.ndim == 2 and len(boxes) == state.shape[0] == 3
+    # box i holds object i: the camera looks across the table along +y, so the nearer an
+    # object's centre is to it (the smaller its y), the lower in the image its box lies
+    y = world.scene.schema.index("y_min"), world.scene.schema.index("y_max")
+    order_by_y = np.argsort([f[y[0]] + f[y[1]] for f in state])
+    order_by_row = np.argsort([-(r0 + r1) for r0, _, r1, _ in boxes])
+    assert list(order_by_y) == list(order_by_row)
+
+
+def test_plot_files_are_checked_before_any_work(pipeline, tmp_path):
+    model = str(pipeline / "model.afford")
+    r = runner.invoke(app, ["predict", model, "--seed", "1", "--plot", str(tmp_path / "p.txt")])
+    assert r.exit_code == 1 and "ending in .png" in r.output
+    r = runner.invoke(app, ["predict", model, "--seed", "1", "--plot", str(tmp_path / "no" / "p.png")])
+    assert r.exit_code == 1 and "does not exist" in r.output
+    r = runner.invoke(app, ["plan", model, "--seed", "1", "--episodes", "2", "--goal", "*:visibility=0",
+                            "--plot", str(tmp_path / "p.png")])
+    assert r.exit_code == 2 and not list(tmp_path.iterdir())

@@ -88,6 +88,16 @@ def test_predict_check_runs_every_move_from_the_same_start(learned):
         assert abs(sum(p["probabilities"].values()) - 1) < 1e-3
 
 
+def test_predict_plot_draws_the_scan_and_each_moves_chance(learned, tmp_path):
+    from matplotlib.image import imread
+
+    out = json.loads(ok(["predict", str(learned / "model.afford"), "--scene", "traverse", "--seed", "4", "--check",
+                         "--plot", str(tmp_path / "scan.png"), "--json"]).stdout)
+    assert out["plot"] == str(tmp_path / "scan.png")
+    image = imread(tmp_path / "scan.png")
+    assert image.shape[1] >= 800 and image.shape[0] >= 300  # the scan beside seven bars
+
+
 def test_commands_refuse_what_does_not_apply_in_one_sentence(learned, tmp_path):
     model = str(learned / "model.afford")
     assert "does not apply to scene 'traverse'" in fails(["explore", "--scene", "traverse", "--size-min", "0.1",

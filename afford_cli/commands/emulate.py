@@ -13,6 +13,7 @@ from afford.features.errors import DataError
 from afford.learning import load_model
 from afford.options import Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
 from afford.output import Output
+from afford.plots import PlotFile, check_plot_file
 from afford.scenes_io import open_world, scene_layout
 
 
@@ -27,10 +28,13 @@ def emulate(
     max_replans: MaxReplans = 3,
     seed: Annotated[int, typer.Option("--seed", "-s", min=0, help="Seed of the simulated worlds (noise).")] = 0,
     alternatives: Alternatives = 3,
+    plot: PlotFile = None,
     json: Json = False,
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
     from afford.plan.emulate import goal_from_observation
+
+    check_plot_file(plot)
     loaded = load_model(model)
     loaded.check_effects("emulation")
     sc, shown = scene_layout(scene, None, observe, allow_empty=True)
@@ -64,6 +68,14 @@ def emulate(
         entry["execution"] = ex.to_json()
     elif not plan.found:
         result["reason"] = plan.reason
+    if plot is not None:
+        from afford.planning import draw_plan
+
+        shown_rows = observed[loaded.schema.visible(observed)] if observed.size else None
+        reached = f"; reached: {'yes' if result['reached'] else 'no'}" if execute and plan.found else ""
+        result["plot"] = draw_plan(plot, loaded.schema, world, state, plan,
+                                   world.perceive() if "execution" in result else None,
+                                   f"emulate: {' and '.join(goal.to_json())}{reached}", shown=shown_rows)
 
     def render(console):
         console.print(f"shown: {len(shown)} object(s); derived goal: {' and '.join(goal.to_json())}")

@@ -16,6 +16,7 @@ from afford.options import (
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
 )
 from afford.output import Output
+from afford.plots import PlotFile, check_plot_file
 from afford.api import parse_goal
 from afford.planning import plan_once
 from afford.scenes_io import make_scene, scene_layout
@@ -79,11 +80,15 @@ def plan(
     episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
     reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
     alternatives: Alternatives = 3,
+    plot: PlotFile = None,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
     check_scene_source(layout, seed, objects=objects, reachable=reachable or None,
                        episodes=episodes if episodes > 1 else None)
+    if plot is not None and episodes > 1:
+        raise typer.BadParameter("--plot draws one scene; it does not go with --episodes")
+    check_plot_file(plot)
     loaded = load_model(model)
     loaded.check_effects("planning")
     g = parse_goal(goal, loaded.schema)
@@ -96,7 +101,7 @@ def plan(
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable)
         entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives,
-                                 say=out.info if execute else None))
+                                 say=out.info if execute else None, plot=plot))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):

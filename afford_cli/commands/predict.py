@@ -18,17 +18,21 @@ from rich.table import Table
 from afford.learning import load_model
 from afford.options import Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
 from afford.output import Output
+from afford.plots import PlotFile, check_plot_file
 from afford.scenes_io import open_world, scene_layout
 
-def check(model, scene, layout, seed: int, preds: list[dict]) -> None:
-    """Run each behaviour from the same start in the simulator; did the prediction hold?"""
+def check(model, scene, layout, seed: int, preds: list[dict]) -> dict:
+    """Run each behaviour from the same start in the simulator; did the prediction hold?
+    Returns what was perceived after each run, by (object, behaviour)."""
     from afford.features import OUTCOMES
 
+    seen = {}
     for entry in preds:
         for name, p in entry["behaviors"].items():
             world = open_world(scene, layout, seed)
             before = world.perceive()
             after = world.act(name, entry["object"])
+            seen[(entry["object"], name)] = after
             if model.label_source == "given":
                 actual = world.last_result
                 p["observed_result"] = model.result_names[actual]
@@ -38,6 +42,49 @@ def check(model, scene, layout, seed: int, preds: list[dict]) -> None:
                 p["outcome"] = OUTCOMES[world.history[-1].outcomes[entry["object"]]]
             p["observed_category"] = actual
             p["held"] = actual == p["category"]
+    return seen
+
+
+def draw(path: str, model, world, state, preds: list[dict], seen: dict | None) -> str:
+    """``--plot``: the start's range image, and per behaviour the scene from above (each
+    object where it is, where that behaviour is predicted to leave it, where it really went)
+    or, for results given (chapter 5), each behaviour's chance of success."""
+    import numpy as np
+
+    from afford.plots import scene_figure
+
+    schema = model.schema
+    if model.label_source == "given":
+        names = list(model.result_names)
+        good = names.index("success") if "success" in names else None
+        results = []
+        for name, p in preds[0]["behaviors"].items():
+            q = p["probabilities"].get(str(good), 0.0) if good is not None else p["probability"]
+            results.append((name, float(q), p.get("observed_result")))
+        return scene_figure(path, schema, view=world.start_view, results=results,
+                            title="predict: the environment as scanned, and each move's chance")
+
+    def row(entry, p):
+        v = np.array(state[entry["object"]], dtype=float)
+        for n, value in p["next"]["features"].items():
+            v[schema.index(n)] = value
+        if schema.visibility_index is not None:
+            v[schema.visibility_index] = 1.0 if p["next"]["visible"] else 0.0
+        return v
+
+    panels = []
+    for name in model.names:
+        predicted = np.array(state, dtype=float)
+        actual = np.array(state, dtype=float) if seen else None
+        for entry in preds:
+            if name in entry["behaviors"]:
+                predicted[entry["object"]] = row(entry, entry["behaviors"][name])
+                if seen:
+                    actual[entry["object"]] = seen[(entry["object"], name)][entry["object"]]
+        panels.append({"title": f"{name} on each object" + (" (and what it did)" if seen else ""),
+                       "start": state, "predicted": predicted, "actual": actual})
+    return scene_figure(path, schema, view=world.start_view, panels=panels,
+                        title="predict: what the robot saw, and where each behaviour would leave each object")
 
 
 def predict(
@@ -48,10 +95,12 @@ def predict(
     layout: Layout = None,
     run_check: Annotated[bool, typer.Option("--check", help="Also run each behaviour in the simulator, every one from the same start, and report whether the prediction held.")] = False,
     want: Annotated[Optional[list[str]], typer.Option("--want", help="Inverse query: rank (object, behaviour, alpha) by the probability that one step makes OBJ:FEATURE=VALUE~RANGE hold.")] = None,
+    plot: PlotFile = None,
     json: Json = False,
 ) -> None:
     """Predict, for every entity the robot sees, what each behaviour would do."""
     check_scene_source(layout, seed, objects=objects)
+    check_plot_file(plot)
     loaded = load_model(model)
     if want:
         loaded.check_effects("an inverse query (--want)")
@@ -60,9 +109,10 @@ def predict(
     state = world.perceive()
     loaded.check_schema(sc.schema, "this scene's perception")
     preds = loaded.predictions(state)
-    if run_check:
-        check(loaded, sc, specs, seed or 0, preds)
+    seen = check(loaded, sc, specs, seed or 0, preds) if run_check else None
     result = {"objects": preds, "layout": sc.layout_json(specs), "label_source": loaded.label_source}
+    if plot is not None:
+        result["plot"] = draw(plot, loaded, world, state, preds, seen)
     if want:
         from afford.api import parse_goal
 
