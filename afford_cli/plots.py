@@ -305,7 +305,8 @@ def confusion_figure(path: Path, behavior: str, metrics: dict) -> str:
     import numpy as np
 
     matrix = np.asarray(metrics["confusion_matrix"], dtype=int)
-    labels = [str(v) for v in metrics["labels"]]
+    names = metrics.get("label_names") or {}
+    labels = [f"{v}: {names[str(v)]}" if str(v) in names else str(v) for v in metrics["labels"]]
     n = len(labels)
     rows = matrix.sum(axis=1, keepdims=True)
     share = np.divide(matrix, rows, out=np.zeros(matrix.shape), where=rows > 0)
@@ -319,7 +320,7 @@ def confusion_figure(path: Path, behavior: str, metrics: dict) -> str:
             if matrix[i, j]:
                 ax.text(j, i, str(matrix[i, j]), ha="center", va="center", fontsize=fontsize,
                         color="white" if share[i, j] > 0.55 else "#1a1a1a")
-    ax.set_xticks(range(n), labels, fontsize=fontsize)
+    ax.set_xticks(range(n), labels, fontsize=fontsize, rotation=35 if names else 0, ha="right" if names else "center")
     ax.set_yticks(range(n), labels, fontsize=fontsize)
     ax.set_xlabel("predicted category", fontsize=9)
     ax.set_ylabel("true category", fontsize=9)
@@ -505,4 +506,38 @@ def scene_figure(path: Path, schema, *, view=None, panels=(), results=None, titl
         import textwrap
 
         fig.suptitle(textwrap.fill(title, 60 * per_row), fontsize=10)
+    return _save(fig, path)
+
+
+def range_images_figure(path: Path, starts: list[dict]) -> str:
+    """Range images of episode starts (``scenes_io.episode_starts``), each detected object
+    outlined and numbered: what the robot saw before its first behaviour."""
+    import numpy as np
+    from matplotlib.patches import Rectangle
+
+    n = len(starts)
+    per_row = min(n, 3)
+    rows = -(-n // per_row)
+    fig = _new_figure(4.4 * per_row, 3.6 * rows)
+    axes = list(np.atleast_1d(fig.subplots(rows, per_row)).ravel())
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    image = None
+    for ax, s in zip(axes, starts):
+        ranges = np.where(np.isfinite(s["ranges"]), s["ranges"], np.nan)
+        image = ax.imshow(ranges, cmap="viridis_r", interpolation="nearest")
+        for i, (r0, c0, r1, c1) in enumerate(s["boxes"]):
+            colour = _OBJECT_COLOURS[i % len(_OBJECT_COLOURS)]
+            ax.add_patch(Rectangle((c0 - 0.5, r0 - 0.5), c1 - c0, r1 - r0, fill=False, lw=1.6, ec=colour))
+            ax.text(c0, r0 - 1.5, str(i), color=colour, fontsize=9, fontweight="bold", va="bottom")
+        found = f": {len(s['boxes'])} object{'s' * (len(s['boxes']) != 1)} detected" if s["boxes"] else ""
+        note = "" if s["matches_recording"] else "\n(re-simulated look differs from the recording)"
+        ax.set_title(f"episode {s['episode']}{found}{note}", fontsize=9)
+        ax.set_xlabel("image column (ray)", fontsize=8)
+        ax.set_ylabel("image row (ray)", fontsize=8)
+        ax.tick_params(labelsize=7)
+    if image is not None:
+        bar = fig.colorbar(image, ax=axes[:n], shrink=0.7)
+        bar.set_label("range (m); blank: nothing hit", fontsize=8)
+    fig.suptitle("what the robot saw at the start of its first episodes (re-simulated from the seed)", fontsize=10)
     return _save(fig, path)

@@ -97,3 +97,22 @@ def render_result_rates(console, rates: dict[str, dict[str, float]]) -> None:
     for b, r in rates.items():
         table.add_row(b, *[f"{100 * r[n]:.1f} %" for n in names])
     console.print(table)
+
+
+def category_name(prototype: dict[str, float]) -> str:
+    """A short description of an effect category from its prototype's numbers (never from
+    ground truth): "vanished", "lifted 25 cm", "+12 cm x", "no change", or, for features
+    that are not a table object's, the largest change ("min_range_0_2 -0.31")."""
+    p = prototype
+    if p.get("visibility", 0.0) <= -0.5:
+        return "vanished"
+    if all(k in p for k in ("x_min", "x_max", "y_min", "y_max", "z_min")):
+        moves = {"x": (p["x_min"] + p["x_max"]) / 2, "y": (p["y_min"] + p["y_max"]) / 2}
+        if p["z_min"] >= 0.05:
+            return f"lifted {100 * p['z_min']:.0f} cm"
+        axis, d = max(moves.items(), key=lambda kv: abs(kv[1]))
+        return "no change" if abs(d) < 0.015 else f"{100 * d:+.0f} cm {axis}"
+    if not p:
+        return "?"
+    name, value = max(p.items(), key=lambda kv: abs(kv[1]))
+    return f"{name} {value:+.2f}"

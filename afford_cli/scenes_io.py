@@ -5,7 +5,7 @@ from __future__ import annotations
 from afford.errors import AffordError
 from afford.features.errors import DataError
 
-__all__ = ["make_scene", "scene_layout", "open_world"]
+__all__ = ["make_scene", "scene_layout", "open_world", "explored_scene", "episode_starts"]
 
 
 def make_scene(name: str, **options):
@@ -54,3 +54,46 @@ def open_world(scene, specs, seed: int):
     if world.perceive().shape[0] == 0:
         raise AffordError("the robot sees no object in this scene")
     return world
+
+
+def explored_scene(description: dict):
+    """The scene an artefact was explored in, rebuilt from its manifest's description, or
+    None when this afford has no such scene or builds it otherwise (its description differs)."""
+    import json
+
+    from afford.sim.registry import SceneNotFound, get_scene
+
+    try:
+        base = get_scene(str(description.get("name")))()
+        scene = base.configure(**base.options_from(description))
+    except (SceneNotFound, DataError, ValueError, TypeError, KeyError):
+        return None
+    same = json.loads(json.dumps(scene.describe())) == json.loads(json.dumps(description))
+    return scene if same else None
+
+
+def episode_starts(description: dict, seed: int | None, data, n: int = 6) -> list[dict]:
+    """What the robot saw at the start of the first ``n`` episodes of an exploration,
+    re-simulated from (seed, episode): per episode its number, the range image, each
+    detected object's pixel box, and whether the re-simulated look matches the recorded one
+    (the same features). Empty when the scene cannot be rebuilt (see :func:`explored_scene`)."""
+    import numpy as np
+
+    from afford.sim.explore import episode_rng
+
+    scene = explored_scene(description)
+    if scene is None or seed is None or len(data) == 0:
+        return []
+    out = []
+    for e in sorted(set(int(x) for x in data.episode))[:n]:
+        rng = episode_rng(seed, e)
+        world = scene.build(scene.sample(rng), rng)
+        look = np.asarray(world.perceive(), dtype=np.float32)
+        view = world.last_view()
+        if view is None:
+            continue
+        first = int(np.flatnonzero(data.episode == e)[0])
+        recorded = data.entities[data.before_index[first]]
+        same = look.shape[0] >= 1 and bool(np.array_equal(look[0], recorded))
+        out.append({"episode": e, "ranges": view[0], "boxes": view[1], "matches_recording": same})
+    return out

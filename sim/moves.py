@@ -143,6 +143,10 @@ class TraverseScene:
         d["learner"] = dict(self.learner)
         return d
 
+    def options_from(self, description: dict) -> dict:
+        g = description.get("grid", {})
+        return {"grid": g.get("cells", self.config.grid.cells), "layers": g.get("layers", self.config.grid.layers)}
+
     def configure(self, grid: int | None = None, layers: int | None = None) -> "TraverseScene":
         g = self.config.grid
         spec = replace(g, cells=g.cells if grid is None else int(grid), layers=g.layers if layers is None else int(layers))

@@ -16,6 +16,8 @@ What a scene declares
 
 What a scene does
     ``configure(**options)`` a scene with those settings (ValueError for a bad value);
+    ``options_from(describe())`` the options that configure a scene so described (to
+    rebuild, from an artefact's manifest, the scene it was explored in);
     ``sample(rng, **kw)`` a random layout; ``parse_layout(text, source)``,
     ``layout_toml(layout)``, ``layout_json(layout)`` and ``check_layout(layout)`` for
     layout files and reports;
@@ -63,6 +65,8 @@ class Scene(Protocol):
     def describe(self) -> dict: ...
 
     def configure(self, **options: Any) -> "Scene": ...
+
+    def options_from(self, description: dict) -> dict[str, Any]: ...
 
     def sample(self, rng: np.random.Generator, **kw: Any) -> Any: ...
 

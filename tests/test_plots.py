@@ -209,3 +209,30 @@ def test_plot_files_are_checked_before_any_work(pipeline, tmp_path):
     r = runner.invoke(app, ["plan", model, "--seed", "1", "--episodes", "2", "--goal", "*:visibility=0",
                             "--plot", str(tmp_path / "p.png")])
     assert r.exit_code == 2 and not list(tmp_path.iterdir())
+
+
+def test_categories_are_named_from_their_prototypes_numbers():
+    from afford.reports import category_name
+
+    still = {"visibility": 0.0, "x_min": 0.0, "x_max": 0.0, "y_min": 0.0, "y_max": 0.0, "z_min": 0.0}
+    assert category_name({**still, "visibility": -1.0}) == "vanished"
+    assert category_name({**still, "z_min": 0.25, "x_min": 0.1, "x_max": 0.1}) == "lifted 25 cm"
+    assert category_name({**still, "x_min": 0.11, "x_max": 0.13}) == "+12 cm x"
+    assert category_name({**still, "y_min": -0.2, "y_max": -0.16, "x_min": 0.05, "x_max": 0.05}) == "-18 cm y"
+    assert category_name({**still, "x_min": 0.01}) == "no change"
+    assert category_name({"min_range_0": -0.31, "theta_3": 0.1}) == "min_range_0 -0.31"
+
+
+def test_evaluate_names_categories_and_inspect_draws_the_first_looks(pipeline, tmp_path):
+    r = runner.invoke(app, ["evaluate", str(pipeline / "model.afford"), str(pipeline / "test.afford"), "--json"])
+    assert r.exit_code == 0, r.output
+    for report in json.loads(r.stdout)["behaviors"].values():
+        assert set(report["label_names"]) == {str(c) for c in report["labels"]}
+        assert all(isinstance(v, str) and v for v in report["label_names"].values())
+    r = runner.invoke(app, ["inspect", str(pipeline / "train.afford"), "--plots", str(tmp_path), "--json"])
+    assert r.exit_code == 0, r.output
+    info = json.loads(r.stdout)
+    assert str(tmp_path / "range-images.png") in info["plots"] and is_png(tmp_path / "range-images.png")
+    # the re-simulated first looks are the ones the exploration recorded, feature for feature
+    assert len(info["range_images"]) == 6
+    assert all(s["matches_recording"] and s["objects"] >= 1 for s in info["range_images"])

@@ -58,6 +58,7 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
             "ece": m["ece"], "confusion_matrix": m["confusion_matrix"], "labels": m["labels"],
             "reliability": reliability_bins(y[known], proba, predictor.classes_),
         }
+        entry["label_names"] = _label_names(model, name, m["labels"])
         entry.update(_open_set(model, name, data, rows, X, y, predictor))
         if baselines:
             arrays = model.art.arrays
@@ -65,6 +66,17 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
                                                  X[known], y[known], random_state=seed)
         out[name] = entry
     return out
+
+
+def _label_names(model, name: str, labels) -> dict[str, str]:
+    """Each label's short name: a given result's own, or a description of the category's
+    prototype (``reports.category_name``); the ids stay the key."""
+    from afford.reports import category_name
+
+    if model.label_source == "given":
+        return {str(int(c)): model.result_names[int(c)] for c in labels}
+    cats = {int(c["id"]): c for c in model.art.manifest.get("categories", {}).get(name, [])}
+    return {str(int(c)): category_name(cats[int(c)].get("prototype", {})) if int(c) in cats else "?" for c in labels}
 
 
 def _open_set(model, name: str, data, rows: np.ndarray, X: np.ndarray, y: np.ndarray, predictor) -> dict:

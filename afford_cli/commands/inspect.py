@@ -162,6 +162,18 @@ def _behaviour_reports(m: dict) -> dict:
     return reports
 
 
+def _start_images(art: Artifact, info: dict, plot_dir) -> list[str]:
+    """The range images of the first episodes' starts, re-simulated (when this afford can
+    rebuild the scene the rows were explored in); ``info["range_images"]`` says what they show."""
+    from afford.plots import range_images_figure
+    from afford.scenes_io import episode_starts
+
+    starts = episode_starts(art.manifest.get("scene", {}), art.manifest.get("seed"), interactions_from_artifact(art))
+    info["range_images"] = [{"episode": s["episode"], "objects": len(s["boxes"]),
+                             "matches_recording": s["matches_recording"]} for s in starts]
+    return [range_images_figure(plot_dir / "range-images.png", starts)] if starts else []
+
+
 def inspect(path: InputPath, json: Json = False, plots: PlotDir = None) -> None:
     """Report any afford artefact (kind, lineage, features, categories, outcomes) and verify its checksums."""
     out = Output(json)
@@ -171,6 +183,8 @@ def inspect(path: InputPath, json: Json = False, plots: PlotDir = None) -> None:
         info = describe(art)
         if plot_dir is not None:
             info["plots"] = artefact_plots(info, plot_dir)
+            if "n_interactions" in art.manifest:
+                info["plots"] += _start_images(art, info, plot_dir)
         out.result(info, lambda console: render(console, info))
     if plot_dir is not None:
         out.info(written(info["plots"]))

@@ -101,6 +101,10 @@ class TableScene:
         d["name"] = self.name
         return d
 
+    def options_from(self, description: dict) -> dict:
+        lo, hi = description.get("size_range", self.config.size_range)
+        return {"size_min": lo, "size_max": hi, "max_steps": description.get("max_steps", self.config.max_steps)}
+
     def configure(self, size_min: float | None = None, size_max: float | None = None,
                   max_steps: int | None = None) -> "TableScene":
         """This scene with other object sizes or episode length (ValueError, one sentence, if bad)."""
