@@ -91,7 +91,7 @@ class Journal:
         (tmp / "episodes.log").touch()
         os.replace(tmp, self.dir)  # the journal appears whole, or not at all
         self.created = True
-        self._log = open(self.dir / "episodes.log", "ab")
+        self._log = self._locked(open(self.dir / "episodes.log", "ab"))
 
     def _open_existing(self) -> None:
         try:
@@ -113,10 +113,23 @@ class Journal:
                 self._meta = json.loads(meta.read_text())
             except (OSError, ValueError):
                 raise AffordError(f"{meta} is unreadable; remove {self.dir} to start afresh") from None
+        log = self._locked(open(self.dir / "episodes.log", "ab"))  # before reading: no one else appends
         end = self._read()
-        with open(self.dir / "episodes.log", "r+b") as f:  # drop a record a killed run left half-written
-            f.truncate(end)
-        self._log = open(self.dir / "episodes.log", "ab")
+        log.truncate(end)  # drop a record a killed run left half-written
+        self._log = log
+
+    def _locked(self, f):
+        """``f``, locked for this process alone: two runs never append to one journal."""
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not POSIX: no lock
+            return f
+        try:
+            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            f.close()
+            raise AffordError(f"another afford explore is writing {self.dir}; wait for it, or stop it first") from None
+        return f
 
     # -- reading ------------------------------------------------------------------------
     def _records(self):

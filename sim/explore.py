@@ -277,9 +277,18 @@ class LocalPool:
             for task in tasks:
                 yield fn(*task)
             return
+        import warnings
+
         from joblib import delayed
 
-        yield from self._parallel(delayed(fn)(*task) for task in tasks)
+        results = self._parallel(delayed(fn)(*task) for task in tasks)
+        try:
+            for result in results:  # not ``yield from``: that would close ``results`` outside the filter below
+                yield result
+        finally:
+            with warnings.catch_warnings():  # an interrupted run cancels its tasks on purpose
+                warnings.filterwarnings("ignore", message=".*tasks which were still being processed", category=UserWarning)
+                results.close()
 
 
 def explore(

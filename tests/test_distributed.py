@@ -231,3 +231,19 @@ def test_a_run_to_a_number_of_interactions_resumes_to_the_same_rows(tmp_path):
     assert len(resumed) == 150
     a, b = interactions_members(one)[0], interactions_members(resumed)[0]
     assert a.keys() == b.keys() and all(a[k].tobytes() == b[k].tobytes() for k in a)
+
+
+def test_two_runs_never_write_one_journal(tmp_path):
+    import afford
+    from afford.errors import AffordError, Interrupted
+
+    journal = tmp_path / "x.afford.partial"
+
+    def second_run_meanwhile(done, total):
+        if done >= 8:
+            with pytest.raises(AffordError, match="another afford explore is writing"):
+                afford.explore("table", episodes=60, seed=5, journal=journal, resume=True)
+            raise KeyboardInterrupt
+
+    with pytest.raises(Interrupted, match="8 finished episodes are kept"):  # the refused run took nothing
+        afford.explore("table", episodes=60, seed=5, journal=journal, progress=second_run_meanwhile)
