@@ -541,3 +541,20 @@ def range_images_figure(path: Path, starts: list[dict]) -> str:
         bar.set_label("range (m); blank: nothing hit", fontsize=8)
     fig.suptitle("what the robot saw at the start of its first episodes (re-simulated from the seed)", fontsize=10)
     return _save(fig, path)
+
+
+def curve_figure(path: Path, curve: list[dict], strategy: str = "") -> str:
+    """Test accuracy against interactions tried, one line per behaviour (``explore --strategy --test``)."""
+    fig = _new_figure(7.0, 4.4)
+    ax = fig.subplots()
+    by: dict[str, list[dict]] = {}
+    for c in curve:
+        by.setdefault(c["behavior"], []).append(c)
+    for name, points in by.items():
+        ax.plot([p["interactions"] for p in points], [100 * p["accuracy"] for p in points], marker=".", lw=1.2, label=name)
+    ax.set_xlabel("interactions tried", fontsize=9)
+    ax.set_ylabel("held-out accuracy (%)", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title(f"learning as it explores{f' ({strategy})' if strategy else ''}", fontsize=10)
+    return _save(fig, path)

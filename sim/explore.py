@@ -376,3 +376,53 @@ def explore(
         data = data.subset(np.arange(interactions))
     return data
 
+
+
+# -- candidates for curiosity-driven exploration (thesis chapter 6) --------------------------
+
+def _try_rng(seed: int, candidate: int, behavior: int) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(candidate, 1 + behavior)))
+
+
+def scan_candidate(scene, seed: int, candidate: int) -> np.ndarray:
+    """Candidate ``candidate`` of a scan scene's stream: a random environment, scanned once;
+    its entity (d,), the same as Algorithm 1's episode of that number perceives."""
+    rng = episode_rng(seed, candidate)
+    layout = scene.sample(rng)
+    return np.asarray(scene.build(layout, rng).perceive(), dtype=np.float32)[0]
+
+
+def try_candidate(scene, seed: int, candidate: int, behavior: int) -> tuple[int, np.ndarray, dict]:
+    """Run behaviour ``behavior`` in candidate ``candidate``'s environment, in a fresh world
+    from its start: (the robot's own result, alpha, ground truth). Every (candidate,
+    behaviour) has its own generator, so the outcome does not depend on what else was tried."""
+    layout = scene.sample(episode_rng(seed, candidate))
+    rng = _try_rng(seed, candidate, behavior)
+    b = scene.behaviors[behavior]
+    alpha = np.array([rng.uniform(p.low, p.high) for p in b.parameters], dtype=float)
+    world = scene.build(layout, rng)
+    execution = b(world, None, alpha)
+    return int(execution.result), alpha, world.truth_row()
+
+
+def _scan_chunk(scene, seed: int, candidates: list[int], in_worker: bool = False) -> list[tuple[int, np.ndarray]]:
+    if in_worker:
+        die_with_parent()
+    return [(c, scan_candidate(scene, seed, c)) for c in candidates]
+
+
+def scan_candidates(scene, n: int, *, seed: int = 0, pool=None, workers: int = 1,
+                    progress: Callable[[int, int], None] | None = None) -> np.ndarray:
+    """The entities (n, d) of candidates 0 .. n-1, scanned on ``pool`` (any order, put back in order)."""
+    if scene.loop != "scan":
+        raise DataError(f"scene {scene.name!r} plays with objects; candidates are the scan scenes' environments")
+    out: dict[int, np.ndarray] = {}
+    own = pool is None
+    pool = LocalPool(workers) if own else pool
+    with pool if own else nullcontext(pool):
+        tasks = [(scene, seed, c, pool.in_processes) for c in _chunks(list(range(n)), 4)]
+        for result in pool.run(_scan_chunk, tasks):
+            out.update(result)
+            if progress is not None:
+                progress(len(out), n)
+    return np.stack([out[c] for c in range(n)]) if n else np.zeros((0, len(scene.schema)), dtype=np.float32)

@@ -14,12 +14,71 @@ from afford.datasets import behaviour_counts, outcome_table, result_rates
 from afford.reports import render_outcome_table, render_result_rates
 from afford.scenes_io import make_scene
 from afford.options import Json, OutputPath, SceneName, Seed, Workers
+from afford.plots import PlotDir, plot_directory
 from afford.output import Output
 
 
 class Backend(str, Enum):
     loky = "loky"
     dask = "dask"
+
+
+class Strategy(str, Enum):
+    random = "random"
+    margin = "margin"
+    entropy = "entropy"
+    committee = "committee"
+
+
+def explore_online_command(output: str, scene: str, strategy: str, *, seed: int, workers: int, grid, layers, tau: float,
+                           bootstrap: int, candidates: int, threshold: float, budget, test, plots, json: bool,
+                           others: dict) -> None:
+    """``explore --strategy``: curiosity-driven exploration (:mod:`afford.curiosity`)."""
+    from afford.artifacts import artifact_bytes, write_artifact
+    from afford.curiosity import explore_online, online_members
+    from afford.learning import read_rows
+
+    given = [k for k, v in others.items() if v is not None]
+    if given:
+        raise typer.BadParameter(f"{given[0]} does not go with --strategy: a curiosity-driven exploration runs "
+                                 "--candidates environments once, on this machine")
+    check_output(output)
+    plot_dir = plot_directory(plots) if plots is not None else None
+    out = Output(json, stdout_busy=writes_stdout(output))
+    sc = make_scene(scene, grid=grid, layers=layers)
+    test_data = read_rows(test, ("interactions",))[1] if test is not None else None
+    start = time.perf_counter()
+    with out.progress(f"curious about {sc.name}", candidates, lazy=True) as update:
+        def progress(stage, done, total):  # scanning the candidates, then each behaviour learned
+            update(done, total)
+
+        data, tried, report = explore_online(sc, strategy, candidates=candidates, bootstrap=bootstrap, tau=tau,
+                                             threshold=threshold, budget=budget, test=test_data, seed=seed,
+                                             workers=workers, progress=progress)
+    arrays, meta = online_members(data, tried, report)
+    write_artifact(output, artifact_bytes("interactions", arrays, meta, seed=seed))
+    result = {**summary(data, time.perf_counter() - start), "output": output, **report}
+    if plot_dir is not None and "curve" in report:
+        from afford.plots import curve_figure
+
+        result["plots"] = [curve_figure(plot_dir / "learning-curve.png", report["curve"], strategy)]
+
+    def render(console):
+        console.print(f"[bold]curious[/] ({strategy}): of {candidates} scanned environments, tried per behaviour: "
+                      + ", ".join(f"{n} {b['tried']}" for n, b in report["behaviors"].items())
+                      + f"; {len(data)} interactions -> {output}")
+        if "curve" in report:
+            last = {}
+            for c in report["curve"]:
+                last[c["behavior"]] = c
+            console.print("test accuracy at the end: " + ", ".join(
+                f"{n} {100 * c['accuracy']:.1f}% ({c['interactions']} tried)" for n, c in last.items()))
+
+    out.result(result, render)
+    if plot_dir is not None and result.get("plots"):
+        from afford.plots import written
+
+        out.info(written(result["plots"]))
 
 
 def run_explore(out: Output, scene, *, episodes: int | None, interactions: int | None, seed: int,
@@ -94,12 +153,34 @@ def explore(
     resume: Annotated[bool, typer.Option("--resume", help="Continue the interrupted run whose finished episodes are journaled in OUTPUT.partial/ (same options); starts afresh if there is none.")] = False,
     episode_start: Annotated[Optional[int], typer.Option("--episode-start", min=0, help="First episode of this shard of a larger exploration (with --episode-count; join shards with 'afford merge').")] = None,
     episode_count: Annotated[Optional[int], typer.Option("--episode-count", min=1, help="Episodes in this shard, from --episode-start (0 by default).")] = None,
+    strategy: Annotated[Optional[Strategy], typer.Option("--strategy", help="Curiosity-driven exploration (thesis chapter 6, scenes whose results are given): scan --candidates environments and act only where the learner finds them interesting: random (all), margin (the thesis: SVM output within --tau), entropy (calibrated probabilities, --threshold bits or --budget), committee (a bootstrap ensemble disagrees).")] = None,
+    tau: Annotated[float, typer.Option("--tau", min=0.0, help="margin: try a candidate whose SVM output lies within this of the boundary (the thesis's 0.5).")] = 0.5,
+    bootstrap: Annotated[int, typer.Option("--bootstrap", min=2, help="Candidates tried first, all of them, to choose the features (ReliefF, once) and fit the first SVM (the thesis's 25).")] = 25,
+    candidates: Annotated[int, typer.Option("--candidates", min=2, help="Candidate environments in the stream (the thesis's 3000).")] = 3000,
+    threshold: Annotated[float, typer.Option("--threshold", min=0.0, max=1.0, help="entropy: try a candidate whose predicted result has at least this entropy, in bits.")] = 0.7,
+    budget: Annotated[Optional[int], typer.Option("--budget", min=1, help="entropy: try about this many candidates per behaviour, the most uncertain (instead of --threshold).")] = None,
+    test: Annotated[Optional[str], typer.Option("--test", metavar="DATA", help="Interactions of the same scene to score the learner on as it goes: --json holds the learning curve.")] = None,
+    plots: PlotDir = None,
     json: Json = False,
 ) -> None:
     """Let the robot explore: random worlds, its behaviours, what happened recorded (Algorithm 5 or 1).
 
     Finished episodes are journaled in OUTPUT.partial/ as they arrive: after Ctrl-C, SIGTERM
-    or a crash, run the same command with --resume to finish, to the same bytes."""
+    or a crash, run the same command with --resume to finish, to the same bytes. With
+    --strategy the robot explores out of curiosity instead (thesis chapter 6)."""
+    if strategy is not None:
+        return explore_online_command(output, scene, strategy.value, seed=seed, workers=workers, grid=grid, layers=layers,
+                                      tau=tau, bootstrap=bootstrap, candidates=candidates, threshold=threshold,
+                                      budget=budget, test=test, plots=plots, json=json,
+                                      others={"--episodes": episodes, "--interactions": interactions,
+                                              "--resume": resume or None, "--episode-start": episode_start,
+                                              "--episode-count": episode_count, "--scheduler": scheduler,
+                                              "--backend": None if backend is Backend.loky else backend.value})
+    for name, value in (("--bootstrap", bootstrap != 25 or None), ("--candidates", candidates != 3000 or None),
+                        ("--tau", tau != 0.5 or None), ("--threshold", threshold != 0.7 or None), ("--budget", budget),
+                        ("--test", test), ("--plots", plots)):
+        if value is not None:
+            raise typer.BadParameter(f"{name} goes with --strategy (curiosity-driven exploration)")
     if episodes is not None and interactions is not None:
         raise typer.BadParameter("give --episodes or --interactions, not both")
     if episode_count is not None and (episodes is not None or interactions is not None):

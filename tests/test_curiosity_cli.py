@@ -1,0 +1,84 @@
+"""Curiosity-driven exploration from the command line (thesis chapter 6, issue 12): the robot
+scans candidate environments and acts only where its learner is unsure."""
+
+from __future__ import annotations
+
+import json
+import zipfile
+import io
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from afford.app import app
+
+runner = CliRunner()
+
+
+def ok(args):
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, (args, r.output)
+    return r
+
+
+@pytest.fixture(scope="module")
+def curious(tmp_path_factory):
+    d = tmp_path_factory.mktemp("curious")
+    ok(["explore", "--scene", "traverse-gaps", "--episodes", "12", "--seed", "50", "--workers", "2", "-o", str(d / "test.afford")])
+    out = json.loads(ok(["explore", "--scene", "traverse-gaps", "--strategy", "margin", "--candidates", "70",
+                         "--bootstrap", "35", "--seed", "3", "--workers", "2", "--test", str(d / "test.afford"),
+                         "--plots", str(d / "figs"), "-o", str(d / "cur.afford"), "--json"]).stdout)
+    return d, out
+
+
+def test_it_tries_the_bootstrap_and_then_only_what_interests_it(curious):
+    d, out = curious
+    with zipfile.ZipFile(d / "cur.afford") as z:
+        tried = np.load(io.BytesIO(z.read("online_tried.npy")), allow_pickle=False)
+    import afford
+
+    data = afford.load_interactions(str(d / "cur.afford"))
+    assert tried.shape == (70, 7) and tried[:35].all()
+    for b, name in enumerate(data.behavior_names):
+        rows = np.flatnonzero(data.behavior == b)
+        assert sorted(data.episode[rows].tolist()) == np.flatnonzero(tried[:, b]).tolist()
+        assert out["behaviors"][name]["tried"] + out["behaviors"][name]["skipped"] == 70
+    assert len(data) == int(tried.sum()) == out["interactions"] < 70 * 7  # some candidates were skipped
+    curve = out["curve"]
+    assert {c["behavior"] for c in curve} == set(data.behavior_names)
+    assert all(0 <= c["accuracy"] <= 1 and 35 <= c["interactions"] <= 70 for c in curve)
+    assert out["plots"] == [str(d / "figs" / "learning-curve.png")]
+
+
+def test_train_takes_what_curiosity_explored(curious, tmp_path):
+    d, _ = curious
+    r = ok(["train", str(d / "cur.afford"), "-o", str(tmp_path / "m.afford"), "--json"])
+    assert set(json.loads(r.stdout)["behaviors"]) == {"go-forward", "turn-left-20", "turn-right-20", "turn-left-40",
+                                                       "turn-right-40", "turn-left-60", "turn-right-60"}
+
+
+def test_a_candidate_is_the_environment_algorithm_1_would_explore_and_workers_do_not_matter(tmp_path):
+    import afford
+    from afford.sim.explore import scan_candidates
+
+    scene = afford.make_scene("traverse-body")
+    explored = afford.explore(scene, episodes=3, seed=8)
+    assert np.array_equal(scan_candidates(scene, 3, seed=8), explored.entities)
+    args = ["explore", "--scene", "traverse-body", "--strategy", "committee", "--candidates", "14", "--bootstrap", "8",
+            "--seed", "4"]
+    ok([*args, "-o", str(tmp_path / "one.afford")])
+    ok([*args, "--workers", "2", "-o", str(tmp_path / "two.afford")])
+    members = lambda p: {n: zipfile.ZipFile(p).read(n) for n in zipfile.ZipFile(p).namelist() if n.endswith(".npy")}
+    assert members(tmp_path / "one.afford") == members(tmp_path / "two.afford")
+
+
+def test_curiosity_options_are_checked(tmp_path):
+    out = str(tmp_path / "x.afford")
+    r = runner.invoke(app, ["explore", "--strategy", "margin", "--candidates", "10", "-o", out])
+    assert r.exit_code == 1 and "needs a scene whose results are given" in r.output
+    r = runner.invoke(app, ["explore", "--tau", "0.2", "-o", out])
+    assert r.exit_code == 2 and "--tau goes with --strategy" in " ".join(r.output.replace("│", " ").split())
+    r = runner.invoke(app, ["explore", "--scene", "traverse", "--strategy", "margin", "--episodes", "5", "-o", out])
+    assert r.exit_code == 2 and "--episodes does not go with --strategy" in " ".join(r.output.replace("│", " ").split())
+    assert not list(tmp_path.iterdir())
