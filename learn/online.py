@@ -131,6 +131,21 @@ def learn_online(
     set, ``curve`` holds the test accuracy after the bootstrap and after every ``every``
     tried candidates, and after the last.
     """
+    import warnings
+
+    from sklearn.exceptions import ConvergenceWarning
+
+    with warnings.catch_warnings():
+        # liblinear stops at its iteration cap on some early fits (a handful of rows in many
+        # dimensions); the SVM it returns is still the one a capped online learner has
+        warnings.simplefilter("ignore", ConvergenceWarning)
+        return _learn_online(X, label, strategy, bootstrap=bootstrap, tau=tau, threshold=threshold, budget=budget,
+                             committee=committee, n_features=n_features, C=C, X_test=X_test, y_test=y_test,
+                             every=every, seed=seed)
+
+
+def _learn_online(X, label, strategy, *, bootstrap, tau, threshold, budget, committee, n_features, C, X_test, y_test,
+                  every, seed) -> OnlineResult:
     from afford.learn.relevance import relieff
 
     if strategy not in STRATEGIES:

@@ -25,3 +25,24 @@ def test_traverse_accuracy_quick_mode_writes_md_png_json_with_the_thesis_beside_
     assert (tmp_path / "sec_5_6_traverse_accuracy.png").read_bytes()[:4] == b"\x89PNG"
     bad = subprocess.run([sys.executable, str(script), "--scenes", "kitchen"], capture_output=True, text=True)
     assert bad.returncode == 1 and bad.stderr.strip().startswith("error: 'kitchen' is not a traverse scene")
+
+
+def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
+    script = SCRIPTS / "fig_6_5_6_6_curiosity.py"
+    subprocess.run([sys.executable, str(script), "--quick", "--candidates", "130", "--test-size", "60", "--orderings", "2",
+                    "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "fig_6_5_6_6_curiosity.json").read_text())
+    assert doc["seed"] == 1 and doc["quick"] and doc["commit"] and doc["n_features"] == 35100
+    rows = doc["rows"]
+    assert {(r["bootstrap"], r["interactions"]) for r in rows if r["figure"] == "6.5"} == {
+        (b, k) for b in (10, 25, 50, 100) for k in (100, 250, 400)}
+    assert {r["tau"] for r in rows if r["figure"] == "6.6"} == {0.05, 0.1, 0.5, 1.0, None}
+    assert {r["strategy"] for r in rows if r["figure"] == "strategies"} == {"random", "margin", "entropy", "committee"}
+    for r in rows:
+        if r["figure"] != "strategies":
+            assert 0.0 <= r["q1"] <= r["median"] <= r["q3"] <= 1.0 and r["thesis"]
+    # random tries every candidate; the curious strategies skip some
+    tried = {r["strategy"]: r["tried"]["median"] for r in rows if r["figure"] == "strategies"}
+    assert tried["random"] == 130 and tried["margin"] < 130
+    assert "Figure 6.5" in (tmp_path / "fig_6_5_6_6_curiosity.md").read_text()
+    assert (tmp_path / "fig_6_5_6_6_curiosity.png").read_bytes()[:4] == b"\x89PNG"
