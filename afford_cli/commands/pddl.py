@@ -39,7 +39,7 @@ def pddl(
     objects: Objects = None,
     layout: Layout = None,
     max_depth: MaxDepth = 5,
-    solve: Annotated[bool, typer.Option("--solve", help="Also solve the deterministic PDDL with Fast Downward (extra afford[pddl]).")] = False,
+    solve: Annotated[bool, typer.Option("--solve", help="Also solve the deterministic PDDL with Fast Downward (the optional pddl extra).")] = False,
     execute: Annotated[bool, typer.Option("--execute", help="Run Fast Downward's plan in the simulator, blind, and say whether the goal held (implies --solve).")] = False,
     json: Json = False,
 ) -> None:
