@@ -40,6 +40,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/learn.py --scene traverse
 	$(PY) benchmarks/plan.py
 	$(PY) benchmarks/emulate.py
+	$(PY) benchmarks/curiosity.py
 
 # every thesis figure's script in its quick mode, then reproduce/index.md linking them
 reproduce: $(STAMP)

@@ -1,0 +1,95 @@
+"""Curiosity's costs (issue 12): is deciding whether a situation is interesting cheap beside acting in it?
+
+    python benchmarks/curiosity.py [--candidates N] [--out benchmarks/results/curiosity.json]
+
+With chapter 6's perception (the `traverse` scene, a 30 x 30 grid in one layer: 35 100
+features) this times, per candidate: the scan (ray casting, no physics), the grid
+features of the scan, and the margin decision on a fitted online SVM (the 250 chosen
+features, scaled, one decision value); per tried candidate: one go-forward in PhysX
+(world build and the move) and the SVM's refit on 100, 500 and 1000 tried rows. It also
+reports the memory 3000 candidates' features take (float32) and this process's peak.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import resource
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks._common import emit  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--candidates", type=int, default=60, help="candidates scanned and tried for the timings")
+    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "curiosity.json"))
+    args = ap.parse_args()
+
+    from afford.features.grid import grid_features
+    from afford.learn.online import learn_online
+    from afford.sim.explore import episode_rng, try_candidate
+    from afford.sim.registry import make_scene
+
+    scene = make_scene("traverse", grid=30, layers=1)
+    spec = scene.config.grid
+    scans, features, X, y, physics = [], [], [], [], []
+    b = [x.name for x in scene.behaviors].index("go-forward")
+    for c in range(args.candidates):
+        rng = episode_rng(7, c)
+        world = scene.build(scene.sample(rng), rng).world
+        t = time.perf_counter()
+        image = world.scan()
+        scans.append(time.perf_counter() - t)
+        t = time.perf_counter()
+        X.append(grid_features(image, spec))
+        features.append(time.perf_counter() - t)
+        t = time.perf_counter()
+        y.append(try_candidate(scene, 7, c, b)[0])
+        physics.append(time.perf_counter() - t)
+    X, y = np.stack(X), np.array(y)
+    run = learn_online(X, y, "random", bootstrap=min(25, len(y)), seed=0)  # a fitted learner, features chosen
+    from afford.learn.online import _Learner
+
+    cols = run.selected
+    lo, span = X[:, cols].min(0), np.ptp(X[:, cols], 0) + 1e-6
+    learner = _Learner(cols, lo, span, 1.0, 0)
+    Z = learner.inputs(X)
+    learner.fit(Z, y if np.unique(y).size > 1 else np.r_[y[:-1], 1 - y[-1]])
+    decide = []
+    for x in X:
+        t = time.perf_counter()
+        abs(float(learner.decision(learner.inputs(x[None, :]))[0])) < 0.5
+        decide.append(time.perf_counter() - t)
+    refit = {}
+    rng = np.random.default_rng(0)
+    for n in (100, 500, 1000):
+        Zn = rng.uniform(0, 1, (n, len(cols)))
+        yn = (Zn[:, 0] + 0.3 * rng.standard_normal(n) > 0.5).astype(int)
+        t = time.perf_counter()
+        learner.fit(Zn, yn)
+        refit[str(n)] = round(1000 * (time.perf_counter() - t), 2)
+    ms = lambda v: round(1000 * float(np.median(v)), 2)
+    result = {
+        "benchmark": "curiosity",
+        "machine": {"python": platform.python_version(), "cpus": __import__("os").cpu_count(),
+                    "platform": platform.platform()},
+        "n_features": int(X.shape[1]), "candidates_timed": args.candidates,
+        "per_candidate_ms": {"scan": ms(scans), "grid_features": ms(features), "margin_decision": ms(decide),
+                             "deciding_with_features": round(ms(features) + ms(decide), 2)},
+        "per_try_ms": {"physics_go_forward": ms(physics)},
+        "refit_ms_by_rows_tried": refit,
+        "memory": {"features_of_3000_candidates_mb": round(3000 * X.shape[1] * 4 / 2**20, 1),
+                   "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)},
+    }
+    emit(result, args.out)
+
+
+if __name__ == "__main__":
+    main()
