@@ -49,6 +49,9 @@ def test_it_tries_the_bootstrap_and_then_only_what_interests_it(curious):
     assert {c["behavior"] for c in curve} == set(data.behavior_names)
     assert all(0 <= c["accuracy"] <= 1 and 35 <= c["interactions"] <= 70 for c in curve)
     assert out["plots"] == [str(d / "figs" / "learning-curve.png")]
+    online = json.loads(ok(["inspect", str(d / "cur.afford"), "--json"]).stdout)["online"]
+    assert online["strategy"] == "margin" and online["bootstrap"] == 35 and online["candidates"] == 70
+    assert {n: b["tried"] for n, b in online["behaviors"].items()} == {n: b["tried"] for n, b in out["behaviors"].items()}
 
 
 def test_train_takes_what_curiosity_explored(curious, tmp_path):

@@ -62,6 +62,7 @@ def describe(art: Artifact) -> dict:
             "n_interactions": m["n_interactions"],
             "n_episodes": m.get("n_episodes"),
             "episode_range": [m["episodes"]["start"], m["episodes"]["stop"]] if isinstance(m.get("episodes"), dict) else None,
+            "online": m.get("online"),
             "counts": behaviour_counts(data),
             "outcomes": outcome_table(data),
             "scene": m.get("scene", {}),
@@ -84,6 +85,11 @@ def render(console, info: dict) -> None:
         head.add_row("interactions", f"{info['n_interactions']} in {info['n_episodes']} episodes" + (
             f" (episodes {span[0]}-{span[1] - 1}: a shard 'afford merge' can join)" if span else ""))
         head.add_row("scene", str(info["scene"].get("name", "?")))
+        online = info.get("online")
+        if isinstance(online, dict) and isinstance(online.get("behaviors"), dict):
+            head.add_row("explored", f"out of curiosity ({online.get('strategy')}, bootstrap {online.get('bootstrap')}): "
+                         f"of {online.get('candidates')} candidates tried " + ", ".join(
+                             f"{n} {b.get('tried')}" for n, b in online["behaviors"].items()))
     console.print(head)
     if info["features"]:
         channels: dict[str, list[str]] = {}
