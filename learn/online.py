@@ -227,10 +227,14 @@ def _learn_online(X, label, strategy, *, bootstrap, tau, threshold, budget, comm
         labels[i] = get(i)
         tried[i] = True
         rows.append(i)
-        refit()
-        if (len(rows) - bootstrap) % every == 0:
+        due = (len(rows) - bootstrap) % every == 0
+        if strategy != "random" or due:  # random never asks the model: fit it only to score it
+            refit()
+        if due:
             score()
     if not curve or curve[-1]["interactions"] != len(rows):
+        if strategy == "random":
+            refit()
         score()
     return OnlineResult(tried=tried, selected=columns, curve=curve, interest=interest, model=learner.svm)
 

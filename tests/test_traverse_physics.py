@@ -177,3 +177,36 @@ def test_layouts_off_the_floor_or_with_overlapping_ramps_are_refused():
         check_layout(TraverseLayout(items=(Item("box", (0.3, 0.3, 0.3), (1000.0, 0.0)),)))
     with pytest.raises(ValueError, match="ramps 0 and 1 overlap"):
         check_layout(TraverseLayout(ramps=(Ramp((0.6, 0.0), 0.0, 1.0, 1.0, 10.0), Ramp((0.7, 0.1), 0.0, 1.0, 1.0, 5.0))))
+
+
+# -- traverse-room (chapter 6): one walled room, the robot somewhere in it --------------------
+
+def test_the_room_stays_and_the_robot_moves_and_another_room_differs():
+    from afford.sim.registry import make_scene
+    from afford.sim.scenes.traverse_room import room_items
+
+    scene = make_scene("traverse-room")
+    a, b = (scene.sample(np.random.default_rng(s)) for s in (1, 2))
+    assert len(a.items) == len(b.items) == len(room_items(0)) == 54
+    dist = lambda lay, i, j: np.hypot(*np.subtract(lay.items[i].position, lay.items[j].position))
+    # the same room seen from two places: distances between its things are kept, positions are not
+    assert dist(a, 30, 40) == pytest.approx(dist(b, 30, 40), abs=1e-3)
+    assert a.items[30].position != b.items[30].position
+    assert room_items(1)[30].position != room_items(0)[30].position
+    assert make_scene("traverse-room", room=1).describe()["room"] == 1
+
+
+def test_a_wall_ahead_stops_the_robot_and_open_floor_does_not():
+    from afford.sim.registry import make_scene
+    from afford.sim.scenes.traverse_room import _in_robot_frame, room_items
+
+    scene = make_scene("traverse-room")
+    walls = tuple(it for it in room_items(0) if it.fixed)
+    forward = scene.behaviors[0]
+    assert forward.name == "go-forward"
+    success = list(scene.results).index("success")
+    near_wall = _in_robot_frame(walls, 2.45, 0.0, 0.0)   # the wall's face 50 cm ahead
+    in_the_middle = _in_robot_frame(walls, 0.0, 0.0, 0.0)
+    blocked = forward(scene.build(near_wall, np.random.default_rng(0)), None, np.zeros(0))
+    free = forward(scene.build(in_the_middle, np.random.default_rng(0)), None, np.zeros(0))
+    assert blocked.result != success and free.result == success

@@ -30,7 +30,7 @@ class Strategy(str, Enum):
     committee = "committee"
 
 
-def explore_online_command(output: str, scene: str, strategy: str, *, seed: int, workers: int, grid, layers, tau: float,
+def explore_online_command(output: str, scene: str, strategy: str, *, seed: int, workers: int, grid, layers, room, tau: float,
                            bootstrap: int, candidates: int, threshold: float, budget, test, plots, json: bool,
                            others: dict) -> None:
     """``explore --strategy``: curiosity-driven exploration (:mod:`afford.curiosity`)."""
@@ -45,7 +45,7 @@ def explore_online_command(output: str, scene: str, strategy: str, *, seed: int,
     check_output(output)
     plot_dir = plot_directory(plots) if plots is not None else None
     out = Output(json, stdout_busy=writes_stdout(output))
-    sc = make_scene(scene, grid=grid, layers=layers)
+    sc = make_scene(scene, grid=grid, layers=layers, room=room)
     test_data = read_rows(test, ("interactions",))[1] if test is not None else None
     start = time.perf_counter()
     with out.progress(f"curious about {sc.name}", candidates, lazy=True) as update:
@@ -148,6 +148,7 @@ def explore(
     size_max: Annotated[Optional[float], typer.Option("--size-max", help="Largest object dimension, metres (scenes with random objects; the table's default 0.40).")] = None,
     grid: Annotated[Optional[int], typer.Option("--grid", min=1, max=60, help="Grid cells per side of the range image (scenes that perceive grid features: 5 in chapter 5, 30 in chapter 6).")] = None,
     layers: Annotated[Optional[int], typer.Option("--layers", min=1, max=8, help="Overlapping grid layers (4 in chapter 5, 1 in chapter 6).")] = None,
+    room: Annotated[Optional[int], typer.Option("--room", min=0, help="Which room (its seed) the robot explores (traverse-room: chapter 6 learns in one room and tests in another; 0 by default).")] = None,
     backend: Annotated[Backend, typer.Option("--backend", help="Where episodes run: loky (processes on this machine) or dask (a LocalCluster of --workers on 127.0.0.1, or the cluster at --scheduler; needs the optional dask extra). The same --seed gives the same bytes on either.")] = Backend.loky,
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", metavar="ADDRESS", help="A running Dask scheduler (tcp://HOST:PORT) to explore on, with --backend dask; its workers need afford installed.")] = None,
     resume: Annotated[bool, typer.Option("--resume", help="Continue the interrupted run whose finished episodes are journaled in OUTPUT.partial/ (same options); starts afresh if there is none.")] = False,
@@ -169,7 +170,7 @@ def explore(
     or a crash, run the same command with --resume to finish, to the same bytes. With
     --strategy the robot explores out of curiosity instead (thesis chapter 6)."""
     if strategy is not None:
-        return explore_online_command(output, scene, strategy.value, seed=seed, workers=workers, grid=grid, layers=layers,
+        return explore_online_command(output, scene, strategy.value, seed=seed, workers=workers, grid=grid, layers=layers, room=room,
                                       tau=tau, bootstrap=bootstrap, candidates=candidates, threshold=threshold,
                                       budget=budget, test=test, plots=plots, json=json,
                                       others={"--episodes": episodes, "--interactions": interactions,
@@ -200,7 +201,7 @@ def explore(
         raise typer.BadParameter(f"--size-min ({size_min}) is larger than --size-max ({size_max})")
     check_output(output)
     out = Output(json, stdout_busy=writes_stdout(output))
-    sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps, grid=grid, layers=layers)
+    sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps, grid=grid, layers=layers, room=room)
     data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
                           workers=workers, episode_start=episode_start or 0, backend=backend.value,
                           scheduler=scheduler, resume=resume)
