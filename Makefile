@@ -45,7 +45,7 @@ bench: $(STAMP)
 # every thesis figure's script in its quick mode, then reproduce/index.md linking them
 reproduce: $(STAMP)
 	@mkdir -p reproduce
-	@for script in examples/reproduce/*.py; do echo "== $$script"; $(PY) $$script --quick --out reproduce || exit 1; done
+	@for script in examples/reproduce/[!_]*.py; do echo "== $$script"; $(PY) $$script --quick --out reproduce || exit 1; done
 	@{ echo "# Thesis figures reproduced (quick mode)"; echo; \
 	  for f in reproduce/*.md; do [ "$$f" = reproduce/index.md ] || echo "- [$$(head -n 1 $$f | sed 's/^# //')]($$(basename $$f))"; done; } > reproduce/index.md
 	@echo "-> reproduce/index.md"

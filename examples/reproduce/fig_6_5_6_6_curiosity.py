@@ -31,15 +31,16 @@ where the thesis states a finding.
 
 from __future__ import annotations
 
-import argparse
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import commit, parser  # noqa: E402
 
 NAME = "fig_6_5_6_6_curiosity"
 CHECKPOINTS = (100, 250, 400)
@@ -50,14 +51,6 @@ THESIS = {
     "6.5": "a bootstrap of 10 stays below 90 %; more than 25 does not further increase the performance",
     "6.6": "tau too small keeps the robot from interesting situations, too large slows learning; tau = 0.5 chosen",
 }
-
-
-def commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                              cwd=Path(__file__).parent, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def _labels(scene, seed: int, candidates: list[int], b: int) -> list[tuple[int, int]]:
@@ -209,11 +202,7 @@ def write(doc: dict, args) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", default="reproduce")
-    ap.add_argument("--workers", type=int, default=2)
+    ap = parser(__doc__)
     ap.add_argument("--candidates", type=int, help="override the mode's number of candidates")
     ap.add_argument("--test-size", type=int, help="override the mode's number of test situations")
     ap.add_argument("--orderings", type=int, help="override the mode's number of orderings")

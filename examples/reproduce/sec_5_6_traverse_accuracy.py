@@ -18,28 +18,21 @@ scene, not per move).
 
 from __future__ import annotations
 
-import argparse
 import json
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from _common import commit, parser  # noqa: E402
 
 NAME = "sec_5_6_traverse_accuracy"
 #: The thesis's figures (5.6.1 and 5.6.2), quoted from its text.
 THESIS = {"traverse": 0.87, "traverse-body": 0.90, "traverse-ramps": 0.95, "traverse-gaps": 0.95}
 SECTION = {"traverse": "5.6.1", "traverse-body": "5.6.2.1", "traverse-ramps": "5.6.2.2", "traverse-gaps": "5.6.2.3"}
-
-
-def commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                              cwd=Path(__file__).parent, check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def scene_rows(name: str, args) -> list[dict]:
@@ -109,11 +102,7 @@ def write(rows: list[dict], args) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--out", default="reproduce")
-    ap.add_argument("--workers", type=int, default=2)
+    ap = parser(__doc__)
     ap.add_argument("--scenes", default=",".join(THESIS))
     args = ap.parse_args()
     names = [s for s in args.scenes.split(",") if s]
