@@ -236,23 +236,20 @@ def explore(scene, *, episodes: int | None = None, interactions: int | None = No
             data = run(sc, episodes=episodes, interactions=interactions, seed=seed, max_steps=max_steps,
                        progress=progress, episode_start=episode_start, pool=pool,
                        done=book.kept if book else None, on_done=book.append if book else None)
-    except KeyboardInterrupt:
+    except BaseException as exc:
         if book is None:
             raise
         book.close()
-        n = len(book.kept)
-        if n == 0 and book.created:
+        if book.created and not book.kept:  # nothing was kept: leave no trace
             book.remove()
             raise
-        raise Interrupted(f"interrupted; {n} finished episode{'s are' if n != 1 else ' is'} kept in {book.dir}: "
-                          "run the same command with --resume to go on") from None
-    except BaseException:
-        if book is not None and book.created and not book.kept:  # nothing was kept: leave no trace
-            book.remove()
+        if isinstance(exc, KeyboardInterrupt):
+            n = len(book.kept)
+            raise Interrupted(f"interrupted; {n} finished episode{'s are' if n != 1 else ' is'} kept in {book.dir}: "
+                              "run the same command with --resume to go on") from None
         raise
-    finally:
-        if book is not None:
-            book.close()
+    if book is not None:
+        book.close()
     if len(data) == 0:
         raise AffordError("exploration recorded no interactions (no object was ever seen)")
     return data

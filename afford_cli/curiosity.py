@@ -52,10 +52,8 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
     behaviour how many were tried and skipped, and with ``test`` interactions of the same
     scene the learning curve ``[{"behavior", "interactions", "accuracy"}]``).
     ``progress(stage, done, total)`` hears the scanning and then each behaviour finished."""
-    from joblib import Parallel, delayed
-
     from afford.features import Interactions
-    from afford.sim.explore import scan_candidates
+    from afford.sim.explore import LocalPool, scan_candidates
 
     if scene.loop != "scan" or not scene.results:
         raise AffordError(f"curiosity-driven exploration needs a scene whose results are given, scanned once per "
@@ -77,14 +75,15 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
         rows = np.flatnonzero(test.behavior == b)
         return test.before_rows(rows), test.result[rows].astype(int)
 
-    jobs = (delayed(_learn_behaviour)(scene, seed, X, b, strategy, settings, *test_of(b), workers > 1) for b in range(B))
     learned = {}
     if progress is not None:
         progress("learning behaviours", 0, B)
-    for b, tried, selected, curve, tries in Parallel(n_jobs=workers, return_as="generator_unordered")(jobs):
-        learned[b] = (tried, selected, curve, tries)
-        if progress is not None:
-            progress("learning behaviours", len(learned), B)
+    with LocalPool(workers) as pool:
+        tasks = [(scene, seed, X, b, strategy, settings, *test_of(b), pool.in_processes) for b in range(B)]
+        for b, tried, selected, curve, tries in pool.run(_learn_behaviour, tasks):
+            learned[b] = (tried, selected, curve, tries)
+            if progress is not None:
+                progress("learning behaviours", len(learned), B)
     pairs = sorted((i, b) for b in range(B) for i in learned[b][3])
     n_params = max((len(b.parameters) for b in scene.behaviors), default=0)
     params = np.zeros((len(pairs), n_params))

@@ -70,10 +70,10 @@ class ScanningWorld:
         self.last_image = self.world.scan()
         return grid_features(self.last_image, self.grid).astype(np.float64)[None, :]
 
-    def last_view(self) -> tuple[np.ndarray, list] | None:
-        """The last scan's ranges (rows, cols; inf where nothing was hit), and no object boxes:
-        this robot perceives the whole environment, not objects."""
-        image = getattr(self, "last_image", None)
+    def last_view(self, image=None) -> tuple[np.ndarray, list] | None:
+        """The last scan's (or ``image``'s) ranges (rows, cols; inf where nothing was hit), and
+        no object boxes: this robot perceives the whole environment, not objects."""
+        image = getattr(self, "last_image", None) if image is None else image
         return None if image is None else (np.asarray(image.ranges), [])
 
     def move(self, rotate: float, drive: float):

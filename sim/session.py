@@ -42,11 +42,15 @@ class SimWorld:
         self.world = scene.build(self.layout, self.rng)
         self._behaviors = {b.name: b for b in scene.behaviors}
         self.state = np.asarray(self.world.perceive())
-        view = getattr(self.world, "last_view", None)
-        #: What the robot saw at the start (see ``last_view`` of the scene's world): the range
-        #: image and each object's pixel box, numbered as the objects are; None if unknown.
-        self.start_view = view() if view is not None else None
+        self._start_image = getattr(self.world, "last_image", None)  # kept, drawn only if asked
         self.history: list[Step | Trial] = []
+
+    @property
+    def start_view(self):
+        """What the robot saw at the start (see ``last_view`` of the scene's world): the range
+        image and each object's pixel box, numbered as the objects are; None if unknown."""
+        view = getattr(self.world, "last_view", None)
+        return view(self._start_image) if view is not None and self._start_image is not None else None
 
     @property
     def behavior_names(self) -> list[str]:

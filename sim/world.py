@@ -189,11 +189,12 @@ class TableWorld:
         self.last_image = image
         return perceive(image, self.config.roi())
 
-    def last_view(self) -> tuple[np.ndarray, list[tuple[int, int, int, int]]] | None:
-        """The last range image (H, W; inf where nothing was hit) and each detected object's
-        pixel box (row0, col0, row1, col1), in the order of the look's feature rows; None
-        before the first look. For pictures: detection runs again on the same image."""
-        image = getattr(self, "last_image", None)
+    def last_view(self, image=None) -> tuple[np.ndarray, list[tuple[int, int, int, int]]] | None:
+        """The last range image (or ``image``, an earlier look's) as (H, W) ranges (inf where
+        nothing was hit) and each detected object's pixel box (row0, col0, row1, col1), in the
+        order of that look's feature rows; None before the first look. For pictures only:
+        detection runs again on the same image."""
+        image = getattr(self, "last_image", None) if image is None else image
         if image is None:
             return None
         boxes = []
