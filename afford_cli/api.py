@@ -94,12 +94,17 @@ def save(data, path: str, *, seed: int | None = None, episodes: tuple[int, int] 
 
 # -- learning: one artefact in, the next out (what cluster | select-features | train do) ------
 
-def cluster(path: str, output: str, *, method: str = "hierarchical", k_max: int = 5, k: int | None = None,
+def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5, k: int | dict | None = None,
             prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
             progress: Callable[[int, int], None] | None = None) -> dict:
     """Discover effect categories per behaviour (thesis 8.4.1, Algorithm 7): reads an
     ``interactions`` artefact, writes ``effects``; returns the summary ``afford cluster
-    --json`` prints. ``progress(done, total)`` is called per behaviour."""
+    --json`` prints. ``progress(done, total)`` is called per behaviour.
+
+    ``method`` None: the scene's own (``clustering`` in its description: chapter 7's
+    crane clusters with k-means, lift into 2), else the hierarchical method. ``k``: one
+    k for every behaviour or ``{behaviour: k, "*": k}``; given with the scene's method,
+    it overrides the scene's k behaviour by behaviour."""
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
@@ -111,6 +116,13 @@ def cluster(path: str, output: str, *, method: str = "hierarchical", k_max: int 
     if not data.has_after:
         raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
                           f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
+    own = data.scene.get("clustering") or {}
+    if method is None:
+        method = own.get("method", "hierarchical")
+        if method == own.get("method") and isinstance(own.get("k"), dict):
+            k = {**own["k"], **(k if isinstance(k, dict) else {} if k is None else {"*": k})}
+    if k is not None and method != "kmeans":
+        raise AffordError("a k goes with the k-means method (--method kmeans)")
     start = time.perf_counter()
     models, labels = discover_effects(data, method=method, k_max=k_max, k=k, prune=prune, min_fraction=min_fraction,
                                       seed=seed, progress=_per_behaviour(progress, data))

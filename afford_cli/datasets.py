@@ -30,7 +30,7 @@ def outcome_table(data: Interactions) -> dict[str, dict[str, dict[str, int]]]:
     for b, name in enumerate(data.behavior_names):
         table[name] = {}
         for s, shape in enumerate(data.shapes):
-            table[name][shape] = {label: int(keys.get((b, s, o), 0)) for o, label in enumerate(OUTCOMES)}
+            table[name][shape] = {label: int(keys.get((b, s, o), 0)) for o, label in enumerate(data.outcome_names)}
     return table
 
 
@@ -62,7 +62,7 @@ def interactions_members(data: Interactions) -> tuple[dict[str, np.ndarray], dic
         "behaviors": data.behaviors,
         "scene": data.scene,
         "shapes": list(data.shapes),
-        "outcome_labels": list(OUTCOMES) if "outcome" in data.truth else [],
+        "outcome_labels": list(data.outcome_names) if "outcome" in data.truth else [],
         "label_source": data.label_source,
         "result_names": list(data.result_names),
         "n_interactions": len(data),
@@ -87,6 +87,7 @@ def interactions_from_artifact(art: Artifact) -> Interactions:
             scene=dict(m.get("scene", {})),
             result=a.get("result"),
             result_names=[str(r) for r in m.get("result_names", [])],
+            outcome_names=[str(o) for o in m.get("outcome_labels") or OUTCOMES],
         )
         rows = {k: a[k] for k in ("behavior", "params", "episode", "step")}
         if "entities" in a:

@@ -24,7 +24,6 @@ from pathlib import Path
 import numpy as np
 
 from afford.errors import AffordError
-from afford.features import OUTCOMES
 from afford.learning import read_effects, read_rows
 
 __all__ = ["FORMATS", "to_frame", "frame_of", "export_bytes", "format_for", "check_extras"]
@@ -73,7 +72,7 @@ def frame_of(data, labels: np.ndarray | None = None):
         extra["category"] = np.asarray(labels, dtype=np.int16)
     for key in sorted(data.truth):
         arr = np.asarray(data.truth[key])
-        named = {"outcome": list(OUTCOMES), "shape": list(data.shapes)}.get(key)
+        named = {"outcome": list(data.outcome_names), "shape": list(data.shapes)}.get(key)
         if named and arr.ndim == 1 and arr.size and 0 <= arr.min() and arr.max() < len(named):
             extra[f"truth.{key}"] = np.asarray(named, dtype=object)[arr.astype(int)]  # by name
         elif arr.ndim == 1:

@@ -15,7 +15,7 @@ import numpy as np
 from afford.artifacts import Artifact, dump_estimator, read_artifact, reading
 from afford.datasets import interactions_from_artifact, interactions_members
 from afford.errors import AffordError
-from afford.features import OUTCOMES, FeatureSchema, Interactions
+from afford.features import FeatureSchema, Interactions
 from afford.learn import TRUSTED_TYPES as PREDICTOR_TYPES
 
 __all__ = [
@@ -50,8 +50,9 @@ def category_report(data: Interactions, labels: np.ndarray, b: int, prototypes: 
             "prototype": {name: round(float(v), 5) for name, v in zip(data.schema.names, prototypes[c])},
         }
         if outcome is not None and members.size:
-            counts = np.bincount(outcome[members], minlength=len(OUTCOMES))
-            entry["outcomes"] = {label: round(float(n / members.size), 4) for label, n in zip(OUTCOMES, counts) if n}
+            counts = np.bincount(outcome[members], minlength=len(data.outcome_names))
+            entry["outcomes"] = {label: round(float(n / members.size), 4)
+                                 for label, n in zip(data.outcome_names, counts) if n}
         out.append(entry)
     return out
 

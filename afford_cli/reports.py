@@ -52,17 +52,16 @@ def render_categories(console, behavior: str, categories: list[dict], channels: 
 
 
 def render_outcome_table(console, outcomes: dict) -> None:
-    """``{behaviour: {shape: {label: count}}}`` as one table."""
-    from afford.features import OUTCOMES
-
+    """``{behaviour: {shape: {label: count}}}`` as one table (its labels as the counts name them)."""
+    labels = next((list(counts) for shapes in outcomes.values() for counts in shapes.values()), [])
     ot = Table(title="what physically happened (ground truth, never used to learn)", box=box.SIMPLE_HEAD)
     ot.add_column("behaviour", no_wrap=True)
     ot.add_column("shape", no_wrap=True, min_width=14)
-    for label in OUTCOMES:
+    for label in labels:
         ot.add_column(label, justify="right", no_wrap=True)
     for behavior, shapes in outcomes.items():
         for shape, counts in shapes.items():
-            ot.add_row(behavior, shape, *[str(counts.get(label, 0)) for label in OUTCOMES])
+            ot.add_row(behavior, shape, *[str(counts.get(label, 0)) for label in labels])
     console.print(ot)
 
 

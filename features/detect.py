@@ -132,8 +132,9 @@ def _masked_gaussian(values: np.ndarray, mask: np.ndarray, sigma: float, size: i
 
 def detect_objects(
     image: RangeImage,
-    roi: RegionOfInterest,
+    roi: RegionOfInterest | None = None,
     *,
+    candidate: np.ndarray | None = None,
     jump: float = 0.02,
     min_pixels: int = 12,
     window: int = 5,
@@ -143,8 +144,11 @@ def detect_objects(
     Parameters
     ----------
     image : RangeImage
-    roi : RegionOfInterest
+    roi : RegionOfInterest, optional
         The volume over the table; the table top itself must lie below it.
+    candidate : (H, W) bool array, optional
+        Pixels that may belong to objects, found otherwise (chapter 7: the pixels that
+        stand out of a scan of the empty world). With ``roi`` too, both must hold.
     jump : float
         Neighbouring pixels whose ranges differ by this much (metres) belong to
         different objects.
@@ -158,10 +162,14 @@ def detect_objects(
     list of Detection, ordered by their first pixel in raster order.
     """
     ranges = image.ranges
+    given = candidate
     candidate = np.isfinite(ranges)
-    hit = np.flatnonzero(candidate)
-    points = image.origin + ranges.ravel()[hit, None] * image.directions.reshape(-1, 3)[hit]
-    candidate.ravel()[hit] = roi.contains(points)
+    if given is not None:
+        candidate &= np.asarray(given, dtype=bool)
+    if roi is not None:
+        hit = np.flatnonzero(candidate)
+        points = image.origin + ranges.ravel()[hit, None] * image.directions.reshape(-1, 3)[hit]
+        candidate.ravel()[hit] = roi.contains(points)
     if image.own_body is not None:
         candidate &= ~image.own_body
     if not candidate.any():

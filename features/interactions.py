@@ -83,6 +83,8 @@ class Interactions:
         What physically happened, for reports and evaluation only.
     shapes : list of str
     scene : dict, the scene's configuration
+    outcome_names : list of str
+        What ``truth["outcome"]`` indexes (the scene's outcomes; the table's by default).
     """
 
     schema: FeatureSchema
@@ -99,6 +101,7 @@ class Interactions:
     truth: dict[str, np.ndarray] = field(default_factory=dict)
     shapes: list[str] = field(default_factory=list)
     scene: dict = field(default_factory=dict)
+    outcome_names: list[str] = field(default_factory=lambda: list(OUTCOMES))
 
     #: Per-row arrays (always present).
     ARRAYS = ("before_index", "behavior", "params", "episode", "step")
@@ -204,7 +207,7 @@ class Interactions:
             after_index=None if self.after_index is None else self.after_index[rows],
             result=None if self.result is None else self.result[rows], result_names=self.result_names,
             truth={k: v[rows] for k, v in self.truth.items()},
-            shapes=self.shapes, scene=self.scene,
+            shapes=self.shapes, scene=self.scene, outcome_names=self.outcome_names,
         )
 
     def compact(self) -> "Interactions":
@@ -236,5 +239,5 @@ class Interactions:
             result=None if first.result is None else np.concatenate([p.result for p in parts]),
             result_names=first.result_names,
             truth={k: np.concatenate([p.truth[k] for p in parts]) for k in first.truth},
-            shapes=first.shapes, scene=first.scene,
+            shapes=first.shapes, scene=first.scene, outcome_names=first.outcome_names,
         )

@@ -15,7 +15,7 @@ from afford.features.detect import Detection, RangeImage, RegionOfInterest, dete
 from afford.features.normals import grid_normals, normal_angles
 from afford.features.schema import N_ANGLE_BINS, object_schema
 
-__all__ = ["object_features", "perceive", "track", "extents", "centres", "N_OBJECT_FEATURES"]
+__all__ = ["object_features", "normal_histograms", "match", "perceive", "track", "extents", "centres", "N_OBJECT_FEATURES"]
 
 _SCHEMA = object_schema()
 N_OBJECT_FEATURES = len(_SCHEMA)
@@ -44,20 +44,25 @@ def _histogram(values: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return counts / total if total else counts.astype(float)
 
 
-def object_features(detection: Detection, camera: np.ndarray, normal_step: int = 5) -> np.ndarray:
-    """The 43-feature vector of one detected object (visibility 1)."""
-    cloud = detection.cloud()
-    lo = cloud.min(axis=0)
-    hi = cloud.max(axis=0)
-    position = np.column_stack([lo, hi]).ravel()  # x_min, x_max, y_min, y_max, z_min, z_max
+def normal_histograms(detection: Detection, camera: np.ndarray, normal_step: int = 5) -> np.ndarray:
+    """The 36 shape features: normalised histograms of the surface normals' elevation and
+    azimuth, 18 bins each (thesis 5.3.1 and 8.3.1)."""
     step = normal_step
     normals = grid_normals(detection.points, camera, n=step)
     while normals.shape[0] < 3 and step > 1:  # a small object: use nearer neighbours
         step -= 1
         normals = grid_normals(detection.points, camera, n=step)
     elevation, azimuth = normal_angles(normals)
-    shape = np.concatenate([_histogram(elevation, _ELEVATION_EDGES), _histogram(azimuth, _AZIMUTH_EDGES)])
-    return np.concatenate([[1.0], position, shape])
+    return np.concatenate([_histogram(elevation, _ELEVATION_EDGES), _histogram(azimuth, _AZIMUTH_EDGES)])
+
+
+def object_features(detection: Detection, camera: np.ndarray, normal_step: int = 5) -> np.ndarray:
+    """The 43-feature vector of one detected object (visibility 1)."""
+    cloud = detection.cloud()
+    lo = cloud.min(axis=0)
+    hi = cloud.max(axis=0)
+    position = np.column_stack([lo, hi]).ravel()  # x_min, x_max, y_min, y_max, z_min, z_max
+    return np.concatenate([[1.0], position, normal_histograms(detection, camera, normal_step)])
 
 
 def perceive(image: RangeImage, roi: RegionOfInterest, **detect_options) -> np.ndarray:
@@ -86,17 +91,31 @@ def track(known: np.ndarray, seen: np.ndarray, gate: float = 0.35) -> np.ndarray
     last features with visibility 0. Detections that match nothing are ignored (the
     robot tracks the objects it started with).
     """
+    return match(known, seen, centres(known), centres(seen), gate, _VISIBLE)
+
+
+def match(known: np.ndarray, seen: np.ndarray, known_at: np.ndarray, seen_at: np.ndarray,
+          gate: float, visibility: int, pairs: bool = False):
+    """Update ``known`` objects from the ``seen`` ones nearest where each was expected.
+
+    ``known_at`` (k, p) are where the known objects are expected now and ``seen_at`` (m, p)
+    where the detections are (any coordinates in which ``gate`` is a distance). Pairs are
+    assigned one to one (Hungarian) within ``gate``; a known object left unmatched keeps its
+    last features with its ``visibility`` column 0. With ``pairs``, also the matched
+    (known, seen) index pairs.
+    """
     out = known.copy()
-    out[:, _VISIBLE] = 0.0
-    if known.shape[0] == 0 or seen.shape[0] == 0:
-        return out
-    cost = np.linalg.norm(centres(known)[:, None, :] - centres(seen)[None, :, :], axis=2)
-    # An object already gone is matched only when no visible one can take the detection:
-    # otherwise a dropped object landing near where another fell off would be mistaken for it.
-    gone = ~_SCHEMA.visible(known)
-    cost = cost + np.where(gone, gate, 0.0)[:, None]
-    rows, cols = linear_sum_assignment(cost)
-    for r, c in zip(rows, cols):
-        if cost[r, c] - (gate if gone[r] else 0.0) <= gate:
-            out[r] = seen[c]
-    return out
+    out[:, visibility] = 0.0
+    matched: list[tuple[int, int]] = []
+    if known.shape[0] and seen.shape[0]:
+        cost = np.linalg.norm(np.asarray(known_at)[:, None, :] - np.asarray(seen_at)[None, :, :], axis=2)
+        # An object already gone is matched only when no visible one can take the detection:
+        # otherwise a dropped object landing near where another fell off would be mistaken for it.
+        gone = known[:, visibility] < 0.5
+        cost = cost + np.where(gone, gate, 0.0)[:, None]
+        rows, cols = linear_sum_assignment(cost)
+        for r, c in zip(rows, cols):
+            if cost[r, c] - (gate if gone[r] else 0.0) <= gate:
+                out[r] = seen[c]
+                matched.append((int(r), int(c)))
+    return (out, matched) if pairs else out

@@ -65,10 +65,25 @@ def _check_rows(data: Interactions, b: int, rows: np.ndarray, what: str) -> None
         raise DataError(f"behaviour {name!r} has only {rows.size} usable interactions; {what} needs at least {MIN_ROWS}")
 
 
-def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max: int = 5, k: int | None = None,
+def k_per_behaviour(k: int | dict | None, names: list[str]) -> dict[str, int | None]:
+    """One k-means k per behaviour from ``k``: a number for all, or ``{name: k}`` with
+    ``"*"`` for the rest (a behaviour left out of both: None, X-means' own choice)."""
+    if not isinstance(k, dict):
+        return {n: k for n in names}
+    unknown = sorted(set(k) - set(names) - {"*"})
+    if unknown:
+        raise DataError(f"there is no behaviour {unknown[0]!r} to give a k; the behaviours are {', '.join(names)}")
+    return {n: k.get(n, k.get("*")) for n in names}
+
+
+def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max: int = 5,
+                     k: int | dict[str, int] | None = None,
                      prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
                      progress: Callable[[int], None] | None = None) -> tuple[dict, np.ndarray]:
     """Effect categories per behaviour; returns ``({name: EffectCategories}, labels)``.
+
+    ``k`` (k-means only): one number for every behaviour, or ``{behaviour: k}`` with ``"*"``
+    for the others (chapter 7 used 2 for lift and varied the moves').
 
     ``labels`` has one entry per row: the row's category within its behaviour, or -1 for a
     row whose category was pruned.
@@ -76,11 +91,12 @@ def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max:
     labels = np.full(len(data), -1, dtype=np.int16)
     models = {}
     effects = data.effects
+    ks = k_per_behaviour(k, data.behavior_names)
     for b, name in enumerate(data.behavior_names):
         rows = behaviour_rows(data, b)
         _check_rows(data, b, rows, "clustering")
         X = predictor_inputs(data.before_rows(rows), data.params[rows], np.arange(len(data.schema)), parameters_of(data, b))
-        ec = EffectCategories(schema=tuple(data.schema.channels), method=method, k_max=k_max, k=k, prune=prune,
+        ec = EffectCategories(schema=tuple(data.schema.channels), method=method, k_max=k_max, k=ks[name], prune=prune,
                               min_fraction=min_fraction, random_state=behaviour_seed(seed, b))
         ec.fit(effects[rows], X)
         labels[rows] = ec.labels_

@@ -77,18 +77,19 @@ class Step:
     outcomes: list[int]                # per tracked object, index into OUTCOMES
 
 
-def interact(world: TableWorld, behavior, target: int, alpha: np.ndarray | None = None,
+def interact(world, behavior, target: int, alpha: np.ndarray | None = None,
              before: np.ndarray | None = None) -> Step:
-    """Run ``behavior`` on tracked object ``target``, let the world settle, perceive again."""
+    """Run ``behavior`` on tracked object ``target`` (none, for a behaviour without a target),
+    let the world settle, perceive again; the world names each tracked object's outcome
+    (``world.outcomes``, indices into its scene's ``outcomes``)."""
     f0 = world.perceive() if before is None else before
     t0 = world.tracked_truth()
     world.contact = False
-    execution = behavior(world, f0[target], alpha)
+    execution = behavior(world, f0[target] if behavior.target is not None else None, alpha)
     world.settle()
     f1 = world.perceive()
     t1 = world.tracked_truth()
-    outcomes = [outcome_label(world, a, b, bool(f1[i, 0])) for i, (a, b) in enumerate(zip(t0, t1))]
-    return Step(f0, f1, t0, t1, execution.executed, world.contact, outcomes)
+    return Step(f0, f1, t0, t1, execution.executed, world.contact, world.outcomes(t0, t1, f1))
 
 
 @dataclass
@@ -172,42 +173,70 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
         step=np.array(rows.step, dtype=np.int16),
         truth=truth,
         shapes=list(SHAPES),
+        outcome_names=list(scene.outcomes),
         scene=scene.describe(),
     )
 
 
 def run_scan_episode(scene, seed: int, episode: int) -> Interactions:
     """One trial of Algorithm 1: a random environment, scanned once, every behaviour tried
-    from the same start in a freshly built world; the label is the robot's own reading."""
+    from the same start in a freshly built world.
+
+    With given labels (chapter 5) the label is the robot's own reading and nothing is
+    perceived after. With discovered labels (chapter 7) the robot looks again after each
+    behaviour, tracking the first object it saw (the episode's one object), and the row's
+    effect is that object's after - before."""
     rng = episode_rng(seed, episode)
     layout = scene.sample(rng)
-    entity = np.asarray(scene.build(layout, rng).perceive(), dtype=np.float32)
-    behaviors = scene.behaviors
-    n_params = max((len(b.parameters) for b in behaviors), default=0)
-    params, results, truth = [], [], []
+    first = scene.build(layout, rng)
+    entity = np.asarray(first.perceive(), dtype=np.float32)
+    discovered = scene.labels == "discovered"
+    behaviors = scene.behaviors if not discovered or entity.shape[0] else ()
+    n_params = max((len(b.parameters) for b in scene.behaviors), default=0)
+    params, results, truth, after = [], [], [], []
     for behavior in behaviors:
         alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
         world = scene.build(layout, rng)
-        execution = behavior(world, None, alpha)
+        if discovered:
+            world.resume(first)
+            step = interact(world, behavior, 0, alpha, before=entity.astype(np.float64))
+            after.append(step.after[0])
+            row = world.truth_row()
+            row["outcome"] = np.int8(step.outcomes[0])
+        else:
+            results.append(behavior(world, None, alpha).result)
+            row = world.truth_row()
         padded = np.zeros(n_params)
         padded[: alpha.size] = alpha
         params.append(padded)
-        results.append(execution.result)
-        truth.append(world.truth_row())
+        truth.append(row)
     n = len(behaviors)
+    d = len(scene.schema)
+    if not truth:  # nothing seen: no rows, but the same truth fields as every other episode
+        row = first.truth_row()
+        if discovered:
+            row["outcome"] = np.int8(0)
+        fields = {k: np.zeros((0, *np.shape(v)), dtype=np.asarray(v).dtype) for k, v in row.items()}
+    else:
+        fields = {k: np.array([t[k] for t in truth]) for k in truth[0]}
+    entities = entity[:1].reshape(-1, d) if discovered else entity.reshape(1, -1)
+    if discovered:
+        entities = np.concatenate([entities, np.asarray(after, dtype=np.float32).reshape(n, d)])
     return Interactions(
         schema=scene.schema,
-        behaviors=[b.to_json() for b in behaviors],
-        entities=entity.reshape(1, -1),
+        behaviors=[b.to_json() for b in scene.behaviors],
+        entities=entities,
         before_index=np.zeros(n, dtype=np.int32),
-        after_index=None,
-        behavior=np.arange(n, dtype=np.int16),
+        after_index=np.arange(1, n + 1, dtype=np.int32) if discovered else None,
+        behavior=np.array([scene.behaviors.index(b) for b in behaviors], dtype=np.int16),
         params=np.array(params, dtype=np.float64).reshape(n, n_params),
         episode=np.full(n, episode, dtype=np.int32),
         step=np.zeros(n, dtype=np.int16),
-        result=np.array(results, dtype=np.int8),
+        result=None if discovered else np.array(results, dtype=np.int8),
         result_names=list(scene.results),
-        truth={k: np.array([t[k] for t in truth]) for k in (truth[0] if truth else {})},
+        truth=fields,
+        shapes=list(SHAPES) if discovered else [],
+        outcome_names=list(getattr(scene, "outcomes", ())),
         scene=scene.describe(),
     )
 

@@ -117,6 +117,7 @@ class TraverseScene:
     behaviors = MOVES
     labels = "given"
     results = RESULTS
+    outcomes: tuple[str, ...] = ()
     loop = "scan"
     options = {
         "grid": "Grid cells per side of the range image (5 in chapter 5, 30 in chapter 6).",

@@ -1,11 +1,11 @@
 """A scene a planner or a predictor can drive: perceive, act, perceive again.
 
 ``SimWorld`` implements the small ``World`` protocol that ``plan`` talks to (``perceive``
-and ``act``), so that closed-loop execution never imports the simulator. For a scene that
-plays (Algorithm 5) it keeps one physics world for the whole session (the objects stay
-where the last behaviour left them); for a scene that scans (Algorithm 1) every behaviour
-starts from the same start in a freshly built world, as in exploration, and the robot
-keeps its own reading of how each went. It keeps every step's ground truth for reports.
+and ``act``), so that closed-loop execution never imports the simulator. For a scene whose
+labels are discovered it keeps one physics world for the whole session (the objects and the
+robot stay where the last behaviour left them, so plans chain); for a scene whose labels are
+given (chapter 5's trials) every behaviour starts from the same start in a freshly built
+world, as in exploration, and the robot keeps its own reading of how each went. It keeps every step's ground truth for reports.
 """
 
 from __future__ import annotations
@@ -77,13 +77,13 @@ class SimWorld:
         if behavior not in self._behaviors:
             raise DataError(f"unknown behaviour {behavior!r}; this scene has {', '.join(self._behaviors)}")
         b = self._behaviors[behavior]
-        if self.scene.loop == "scan":
+        if self.scene.labels == "given":
             world = self.scene.build(self.layout, self.rng)  # every behaviour from the same start
             execution = b(world, None, alpha)
             self.history.append(Trial(behavior, execution.executed, execution.result, execution.reading,
                                       world.truth_row()))
             return self.perceive()
-        if not 0 <= target < self.state.shape[0]:
+        if b.target is not None and not 0 <= target < self.state.shape[0]:
             raise DataError(f"there is no object {target}; the robot sees {self.state.shape[0]}")
         step = interact(self.world, self._behaviors[behavior], target, alpha, before=self.state)
         self.history.append(step)

@@ -230,6 +230,12 @@ class TableWorld:
             identity[r] = int(c)
         self.identity = identity
 
+    def outcomes(self, before: list[ObjectTruth], after: list[ObjectTruth], perceived: np.ndarray) -> list[int]:
+        """Each tracked object's ground-truth outcome (an index into ``features.OUTCOMES``)."""
+        from afford.sim.explore import outcome_label
+
+        return [outcome_label(self, a, b, bool(perceived[i, 0])) for i, (a, b) in enumerate(zip(before, after))]
+
     def tracked_truth(self) -> list[ObjectTruth]:
         """Ground truth in the order of the tracked objects."""
         truth = self.truth()

@@ -22,12 +22,29 @@ class Prune(str, Enum):
     predictability = "predictability"
 
 
+def parse_k(values: list[str] | None) -> dict[str, int] | None:
+    """``--k 4 --k lift=2`` as ``{"*": 4, "lift": 2}`` (a usage error, one sentence, if malformed)."""
+    if not values:
+        return None
+    out: dict[str, int] = {}
+    for v in values:
+        name, _, number = v.rpartition("=")
+        try:
+            n = int(number)
+        except ValueError:
+            raise typer.BadParameter(f"--k takes K or BEHAVIOUR=K with K a whole number, got {v!r}") from None
+        if not 2 <= n <= 50:
+            raise typer.BadParameter(f"--k must be 2-50 clusters, got {n}")
+        out[name.strip() or "*"] = n
+    return out
+
+
 def cluster(
     path: InputPath,
     output: OutputPath,
-    method: Annotated[Method, typer.Option(help="Channel-wise X-means with a Cartesian product (chapter 8), or one-level k-means (chapter 7).")] = Method.hierarchical,
+    method: Annotated[Optional[Method], typer.Option(help="Channel-wise X-means with a Cartesian product (chapter 8), or one-level k-means (chapter 7). Default: the scene's own (crane-lift: kmeans), else hierarchical.")] = None,
     kmax: Annotated[int, typer.Option("--kmax", min=1, max=20, help="Most categories X-means may find in one channel.")] = 5,
-    k: Annotated[Optional[int], typer.Option("--k", min=2, max=50, help="Clusters of --method kmeans.")] = None,
+    k: Annotated[Optional[list[str]], typer.Option("--k", help="Clusters of k-means: K for every behaviour, or BEHAVIOUR=K for one (repeat the option).")] = None,
     prune: Annotated[Prune, typer.Option(help="Drop rare categories (chapter 8) or unpredictable ones (Algorithm 7).")] = Prune.frequency,
     min_fraction: Annotated[float, typer.Option("--min-fraction", min=0.0, max=0.5, help="Frequency pruning: smallest share a category must hold.")] = 0.03,
     seed: Seed = 0,
@@ -36,12 +53,13 @@ def cluster(
     """Discover effect categories per behaviour, without labels (thesis 8.4.1, Algorithm 7)."""
     from afford.api import cluster as run
 
-    if k is not None and method is not Method.kmeans:
+    ks = parse_k(k)
+    if ks is not None and method is Method.hierarchical:
         raise typer.BadParameter("--k goes with --method kmeans")
     check_output(output)
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress("clustering effects (behaviours)", None) as update:
-        result = run(path, output, method=method.value, k_max=kmax, k=k, prune=prune.value,
+        result = run(path, output, method=None if method is None else method.value, k_max=kmax, k=ks, prune=prune.value,
                      min_fraction=min_fraction, seed=seed, progress=update)
 
     def render(console):

@@ -24,8 +24,6 @@ from afford.scenes_io import open_world, scene_layout
 def check(model, scene, layout, seed: int, preds: list[dict]) -> dict:
     """Run each behaviour from the same start in the simulator; did the prediction hold?
     Returns what was perceived after each run, by (object, behaviour)."""
-    from afford.features import OUTCOMES
-
     seen = {}
     for entry in preds:
         for name, p in entry["behaviors"].items():
@@ -39,7 +37,7 @@ def check(model, scene, layout, seed: int, preds: list[dict]) -> dict:
             else:
                 effect = after[entry["object"]] - before[entry["object"]]
                 actual = int(model.effects[name].assign(effect[None, :])[0])
-                p["outcome"] = OUTCOMES[world.history[-1].outcomes[entry["object"]]]
+                p["outcome"] = scene.outcomes[world.history[-1].outcomes[entry["object"]]]
             p["observed_category"] = actual
             p["held"] = actual == p["category"]
     return seen

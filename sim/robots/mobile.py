@@ -84,6 +84,9 @@ class MobileRobotConfig:
     """Scanner head (length, width), on top of the body at its front edge."""
     mass: float = 22.0
     """Body mass (KURT3D weighs about 22 kg)."""
+    com_x: float = 0.0
+    """Where the body's centre of mass lies ahead of its centre (negative: behind; a crane's
+    counterweight)."""
     wheel_radius: float = 0.06
     wheel_mass: float = 0.5
     wheel_inertia: float = 0.01
@@ -181,6 +184,9 @@ class Odometry:
     """IMU: how far the body leans from level at the end."""
     time_s: float
     """Simulated time the behaviour took."""
+    dx_m: float = 0.0
+    dy_m: float = 0.0
+    """Dead reckoning: the displacement's components in the frame the robot started in."""
     heading_tolerance_deg: float = 5.0
     displacement_range: tuple[float, float] = (0.65, 0.75)
     slip_tolerance_deg: float = 10.0
@@ -269,7 +275,7 @@ class MobileRobot:
         # Mass and inertia of the body as a uniform main box (the head is light).
         (_, _, zc), (hx, hy, hz) = c.body_boxes()[0]
         inertia = c.mass / 3 * np.array([hy ** 2 + hz ** 2, hx ** 2 + hz ** 2, hx ** 2 + hy ** 2])
-        base.set_mass_and_inertia(c.mass, sapien.Pose([0.0, 0.0, zc]), inertia)
+        base.set_mass_and_inertia(c.mass, sapien.Pose([c.com_x, 0.0, zc]), inertia)
         r = c.wheel_radius
         for name in WHEELS:
             side, i = name.split("-")[1], int(name.split("-")[2])
@@ -283,6 +289,7 @@ class MobileRobot:
                                    pose_in_child=sapien.Pose(q=_AXLE_Y))
             w.add_sphere_collision(radius=r, material=wheel_material)
             w.set_mass_and_inertia(c.wheel_mass, sapien.Pose(), np.full(3, c.wheel_inertia))
+        self._add_links(ab, base)
         self.articulation = ab.build(fix_root_link=False)
         self.articulation.set_name("mobile-robot")
         self.articulation.set_sleep_threshold(0.0)  # its drives act every step: never asleep
@@ -304,6 +311,9 @@ class MobileRobot:
         self.start_z = float(floor)
         self._torque = math.nan
         self._set_drive(0.0, 0.0, c.drive_torque)
+
+    def _add_links(self, builder, base) -> None:
+        """Add more links to the body before it is built (a crane, an arm); none here."""
 
     # -- senses ---------------------------------------------------------------------------
     def gyro(self) -> float:
@@ -402,6 +412,8 @@ class MobileRobot:
             slip_deg=math.degrees(encoder_turn - (odo.yaw - yaw0)),
             tilt_deg=self.tilt(),
             time_s=float(odo.t),
+            dx_m=float(odo.x),
+            dy_m=float(odo.y),
             heading_tolerance_deg=c.heading_tolerance_deg,
             displacement_range=c.displacement_range,
             slip_tolerance_deg=c.slip_tolerance_deg,

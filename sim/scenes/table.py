@@ -36,6 +36,7 @@ from dataclasses import replace
 
 from afford.features import object_schema
 from afford.features.errors import DataError
+from afford.features.interactions import OUTCOMES
 from afford.sim.behaviors import TABLE_BEHAVIORS
 from afford.sim.camera import RangeCamera
 from afford.sim.layout import layout_toml, parse_layout
@@ -79,6 +80,7 @@ class TableScene:
     summary = "a hand pushes and lifts one random object on a table (thesis chapter 8)"
     labels = "discovered"
     results: tuple[str, ...] = ()
+    outcomes = OUTCOMES
     loop = "play"
     options = {
         "size_min": "Smallest object dimension, metres (0.02-0.6).",

@@ -1,0 +1,66 @@
+"""The mobile crane through the one command line: explore, cluster with the scene's k-means, plan and execute."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from afford.app import app
+
+runner = CliRunner()
+
+
+def ok(args):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, (args, result.output)
+    return result
+
+
+def fails(args, code=1):
+    result = runner.invoke(app, args)
+    assert result.exit_code == code, (args, result.output)
+    assert "Traceback" not in result.output
+    return result.output
+
+
+@pytest.fixture(scope="module")
+def explored(tmp_path_factory):
+    d = tmp_path_factory.mktemp("crane")
+    ok(["explore", "--scene", "crane-lift", "--episodes", "150", "--seed", "1", "--workers", "2", "-o", str(d / "i.afford")])
+    return d
+
+
+def test_the_scene_clusters_with_its_own_k_means_and_lift_splits_lifted_from_not(explored):
+    d = explored
+    out = json.loads(ok(["cluster", str(d / "i.afford"), "-o", str(d / "e.afford"), "--json"]).stdout)
+    lift = out["behaviors"]["lift"]
+    assert lift["n_categories"] == 2
+    shares = [c["outcomes"].get("lifted", 0.0) for c in lift["categories"]]
+    assert max(shares) > 0.9 and min(shares) < 0.1, "one category is the lifts, the other is not"
+    assert out["behaviors"]["move-forward"]["n_categories"] <= 4
+
+
+def test_k_per_behaviour_and_bad_k_in_one_sentence(explored):
+    d = explored
+    out = json.loads(ok(["cluster", str(d / "i.afford"), "-o", str(d / "e6.afford"), "--k", "6", "--k", "lift=3",
+                         "--min-fraction", "0", "--json"]).stdout)
+    assert out["behaviors"]["lift"]["n_categories"] == 3
+    assert out["behaviors"]["move-forward"]["n_categories"] == 6
+    msg = fails(["cluster", str(d / "i.afford"), "-o", str(d / "x.afford"), "--k", "jump=3"])
+    assert "no behaviour 'jump'" in msg
+    assert not (d / "x.afford").exists()
+    fails(["cluster", str(d / "i.afford"), "-o", str(d / "x.afford"), "--k", "lift=two"], code=2)
+
+
+def test_a_move_then_lift_plan_is_found_and_reaches_its_goal_in_simulation(explored):
+    d = explored
+    ok(["train", str(d / "e.afford"), "-o", str(d / "m.afford")])
+    # An upright cylinder beyond the crane, ahead and to the left: it must be approached first.
+    (d / "far.toml").write_text('[[object]]\nshape = "cylinder"\nsize = [0.3, 0.3]\nposition = [0.9, 0.2]\n')
+    out = json.loads(ok(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--layout", str(d / "far.toml"),
+                         "--goal", "*:r_b>180", "--search", "bfs", "--max-depth", "4", "--execute", "--json"]).stdout)
+    names = [s["behavior"] for s in out["plan"]["steps"]]
+    assert names[-1] == "lift" and len(names) >= 2, names
+    assert out["execution"]["reached"]
