@@ -24,7 +24,7 @@ import numpy as np
 from afford.features.errors import DataError
 from afford.features.grid import GridSpec, grid_features, grid_schema
 from afford.sim.behaviors import Behavior, Execution
-from afford.sim.traverse import ROTATIONS, TraverseConfig, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout
+from afford.sim.traverse import ROTATIONS, TraverseConfig, TraverseLayout, TraverseLayoutFiles, TraverseWorld, check_layout
 
 __all__ = ["MOVES", "RESULTS", "TraverseScene", "TraverseSceneConfig", "ScanningWorld", "move_name"]
 
@@ -108,7 +108,7 @@ class TraverseSceneConfig:
     """Grid features of the range image (cells, overlapping layers)."""
 
 
-class TraverseScene:
+class TraverseScene(TraverseLayoutFiles):
     """What the traverse scenes share: the robot, its scanner and grid perception, its seven moves.
 
     A subclass sets ``name``, ``summary`` and :meth:`sample`.
@@ -156,18 +156,8 @@ class TraverseScene:
     def sample(self, rng: np.random.Generator) -> TraverseLayout:  # pragma: no cover - each scene has its own
         raise NotImplementedError
 
-    def parse_layout(self, text: str, source: str = "layout") -> TraverseLayout:
-        return parse_layout(text, source)
-
-    def layout_toml(self, layout: TraverseLayout) -> str:
-        return layout_toml(layout)
-
-    def layout_json(self, layout: TraverseLayout) -> dict:
-        return layout.to_dict()
-
     def check_layout(self, layout: TraverseLayout) -> None:
-        if not isinstance(layout, TraverseLayout):
-            raise DataError(f"that is not a layout of scene {self.name!r}")
+        self._check_kind(layout)
         check_layout(layout, self.config.world.robot)
 
     def build(self, layout: TraverseLayout, rng: np.random.Generator) -> ScanningWorld:

@@ -76,7 +76,7 @@ from afford.sim.scanner import RangeScanner, ScannerConfig
 __all__ = [
     "Item", "Ramp", "Gap", "TraverseLayout", "TraverseConfig", "TraverseWorld", "ROTATIONS",
     "sample_clutter", "sample_body", "sample_ramp", "sample_gap",
-    "parse_layout", "layout_toml", "check_layout",
+    "parse_layout", "layout_toml", "check_layout", "TraverseLayoutFiles",
 ]
 
 #: The seven behaviours' rotations, degrees (left positive), right to left.
@@ -567,6 +567,25 @@ def layout_toml(layout: TraverseLayout) -> str:
         lines += ["[[gap]]", f"distance = {float(g.distance)!r}", f"width = {float(g.width)!r}",
                   f"yaw = {float(g.yaw)!r}", ""]
     return "\n".join(lines)
+
+
+class TraverseLayoutFiles:
+    """What every scene whose layouts are :class:`TraverseLayout` does with layout files."""
+
+    name = ""
+
+    def parse_layout(self, text: str, source: str = "layout") -> TraverseLayout:
+        return parse_layout(text, source)
+
+    def layout_toml(self, layout: TraverseLayout) -> str:
+        return layout_toml(layout)
+
+    def layout_json(self, layout: TraverseLayout) -> dict:
+        return layout.to_dict()
+
+    def _check_kind(self, layout) -> None:
+        if not isinstance(layout, TraverseLayout):
+            raise DataError(f"that is not a layout of scene {self.name!r}")
 
 
 # -- the world --------------------------------------------------------------------------------

@@ -5,24 +5,8 @@ from __future__ import annotations
 import json
 
 import pytest
-from typer.testing import CliRunner
 
-from afford.app import app
-
-runner = CliRunner()
-
-
-def ok(args):
-    result = runner.invoke(app, args)
-    assert result.exit_code == 0, (args, result.output)
-    return result
-
-
-def fails(args, code=1):
-    result = runner.invoke(app, args)
-    assert result.exit_code == code, (args, result.output)
-    assert "Traceback" not in result.output
-    return result.output
+from tests.clitools import fails, ok
 
 
 @pytest.fixture(scope="module")

@@ -6,25 +6,10 @@ import json
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
-from afford.app import app
+from tests.clitools import fails, ok
 
-runner = CliRunner()
 TRAVERSE = ("traverse", "traverse-body", "traverse-gaps", "traverse-ramps")
-
-
-def ok(args):
-    result = runner.invoke(app, args)
-    assert result.exit_code == 0, (args, result.output)
-    return result
-
-
-def fails(args, code=1):
-    result = runner.invoke(app, args)
-    assert result.exit_code == code, (args, result.output)
-    assert "Traceback" not in result.output
-    return result.output
 
 
 @pytest.fixture(scope="module")

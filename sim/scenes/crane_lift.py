@@ -45,7 +45,7 @@ from afford.sim.behaviors import Behavior, Execution
 from afford.sim.crane import CRANE_OUTCOMES, DRIVE, CraneWorld, CraneWorldConfig
 from afford.sim.objects import SHAPES
 from afford.sim.registry import register_scene
-from afford.sim.traverse import Item, TraverseLayout, _rects_overlap, _robot_footprint, check_layout, layout_toml, parse_layout
+from afford.sim.traverse import Item, TraverseLayout, TraverseLayoutFiles, _rects_overlap, _robot_footprint, check_layout
 
 __all__ = ["CraneLiftScene", "CraneSceneConfig", "CRANE_BEHAVIORS", "BUTTON"]
 
@@ -95,7 +95,7 @@ class CraneSceneConfig:
 
 
 @register_scene("crane-lift")
-class CraneLiftScene:
+class CraneLiftScene(TraverseLayoutFiles):
     """The chapter 7 mobile crane (see the module docstring for its task sheet)."""
 
     name = "crane-lift"
@@ -174,18 +174,8 @@ class CraneLiftScene:
             raise DataError(f"could not place {wanted} objects apart within {self.config.distance:g} m; try fewer")
         return TraverseLayout(items=tuple(items))
 
-    def parse_layout(self, text: str, source: str = "layout") -> TraverseLayout:
-        return parse_layout(text, source)
-
-    def layout_toml(self, layout: TraverseLayout) -> str:
-        return layout_toml(layout)
-
-    def layout_json(self, layout: TraverseLayout) -> dict:
-        return layout.to_dict()
-
     def check_layout(self, layout: TraverseLayout) -> None:
-        if not isinstance(layout, TraverseLayout):
-            raise DataError(f"that is not a layout of scene {self.name!r}")
+        self._check_kind(layout)
         if layout.ramps or layout.gaps:
             raise DataError("the crane-lift scene has a flat floor: a layout of it holds objects only")
         for i, it in enumerate(layout.items):
