@@ -116,11 +116,11 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5
     if not data.has_after:
         raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
                           f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
-    own = data.scene.get("clustering") or {}
-    if method is None:
+    if method is None:  # the scene's own clustering; a k given here overrides its k
+        own = data.scene.get("clustering") or {}
         method = own.get("method", "hierarchical")
-        if method == own.get("method") and isinstance(own.get("k"), dict):
-            k = {**own["k"], **(k if isinstance(k, dict) else {} if k is None else {"*": k})}
+        if own.get("k"):
+            k = {**own["k"], **({} if k is None else k if isinstance(k, dict) else {"*": k})}
     if k is not None and method != "kmeans":
         raise AffordError("a k goes with the k-means method (--method kmeans)")
     start = time.perf_counter()

@@ -146,8 +146,7 @@ class CraneWorld:
         self.contact = False
         self.executed = True
         self.odometry: Odometry | None = None
-        self._start = self.truth()
-        self._before = self._start
+        self._before = self.truth()
         self._steps = 0
 
     # -- sensing ---------------------------------------------------------------------------
@@ -248,11 +247,14 @@ class CraneWorld:
         return self.identity.index(body) if body is not None and body in self.identity else None
 
     def _carried_place(self) -> np.ndarray:
-        """Where a held object hangs, robot frame (the crane at rest: the robot knows its arm)."""
+        """Where a held object hangs, robot frame (the crane at rest: the robot knows its arm);
+        its height is a middle-sized object's centre, 15 cm below the plate (tracking gates
+        at 30 cm, and the place is corrected from the next look)."""
         k = self.config.crane
         slew, boom, drop = k.stow
         th = math.radians(slew)
-        return np.array([k.mast_x + boom * math.cos(th), boom * math.sin(th), k.boom_height - drop - 0.15])
+        plate = k.boom_height - drop - 2 * k.plate_half[2]
+        return np.array([k.mast_x + boom * math.cos(th), boom * math.sin(th), plate - 0.15])
 
     def lift(self, target: np.ndarray) -> bool:
         """Lift the object these features describe (see the module docstring); was it in reach?"""
@@ -271,13 +273,9 @@ class CraneWorld:
         stow = c.crane.stow
         robot.drive_crane((slew, boom, stow[2]), self._step)
         objects = set(self.components)
-        touched: dict = {}
-        floor_gap = 0.004
 
-        def pressing() -> bool:
-            touched.clear()
-            touched.update(robot.plate_contacts(objects))
-            return bool(touched) or robot.plate_bottom()[2] < floor_gap
+        def pressing() -> bool:  # on an object, or all but on the floor
+            return bool(robot.plate_contacts(objects)) or robot.plate_bottom()[2] < 0.004
 
         robot.drive_crane((slew, boom, c.crane.drop_limit), self._step, until=pressing, settle=0.0)
         # Press on a little (1 cm further down), reading the contact patch: the magnet grips on an area.

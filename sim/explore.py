@@ -33,35 +33,17 @@ from afford.features import Interactions
 from afford.features.errors import DataError
 from afford.features.interactions import OUTCOMES
 from afford.sim.objects import SHAPES
-from afford.sim.world import ObjectTruth, TableWorld
+from afford.sim.world import LIFTED, ObjectTruth, outcome_label  # noqa: F401  (re-exported)
 
 __all__ = ["explore", "LocalPool", "run_episode", "run_scan_episode", "interact", "Step", "episode_rng", "outcome_label",
            "MOVED", "LIFTED"]
 
 #: A perceived position change above this (metres) counts as "the object moved".
 MOVED = 0.015
-#: Ground truth: an object whose bottom ends this far above the table top was lifted.
-LIFTED = 0.05
 
 
 def episode_rng(seed: int, episode: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(entropy=seed, spawn_key=(episode,)))
-
-
-def outcome_label(world: TableWorld, before: ObjectTruth, after: ObjectTruth, visible: bool) -> int:
-    """The first ground-truth label that applies (index into OUTCOMES)."""
-    top = world.config.table_top
-    if after.position[2] < top:
-        return OUTCOMES.index("fell")
-    if not visible:
-        return OUTCOMES.index("left-view")
-    if after.bottom >= top + LIFTED:
-        return OUTCOMES.index("lifted")
-    moved = float(np.linalg.norm(after.position - before.position))
-    turned = 2 * np.degrees(np.arccos(np.clip(abs(float(np.dot(after.quaternion, before.quaternion))), 0, 1)))
-    if moved >= 0.02 or turned >= 10.0:
-        return OUTCOMES.index("dragged")
-    return OUTCOMES.index("no-change")
 
 
 @dataclass(frozen=True)
@@ -236,7 +218,7 @@ def run_scan_episode(scene, seed: int, episode: int) -> Interactions:
         result_names=list(scene.results),
         truth=fields,
         shapes=list(SHAPES) if discovered else [],
-        outcome_names=list(getattr(scene, "outcomes", ())),
+        outcome_names=list(scene.outcomes),
         scene=scene.describe(),
     )
 

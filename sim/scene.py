@@ -8,7 +8,8 @@ What a scene declares
     ``name``, ``summary``; ``schema`` (the :class:`features.FeatureSchema` of its
     entities); ``behaviors`` (:class:`sim.behaviors.Behavior`, each with its target and
     parameters); ``labels``: ``"discovered"`` (effects to cluster) or ``"given"`` (the
-    robot's own success reading, named by ``results``); ``loop``: ``"play"`` (Algorithm 5:
+    robot's own success reading, named by ``results``); ``outcomes``: the names of the
+    ground-truth outcomes its worlds report (for reports only; empty if none); ``loop``: ``"play"`` (Algorithm 5:
     one object, behaviours until it stops changing) or ``"scan"`` (Algorithm 1: one
     environment, scanned once, every behaviour from the same start in a rebuilt world);
     ``options``: the scene-specific settings a command may pass (name -> help text);
@@ -55,6 +56,7 @@ class Scene(Protocol):
     behaviors: tuple
     labels: str
     results: tuple[str, ...]
+    outcomes: tuple[str, ...]
     loop: str
     options: dict[str, str]
     sample_options: tuple[str, ...]

@@ -17,13 +17,17 @@ import sapien
 from afford.features import RegionOfInterest, perceive, track
 from afford.features.detect import detect_objects
 from afford.features.errors import DataError
+from afford.features.interactions import OUTCOMES
 from afford.features.objects import N_OBJECT_FEATURES
 from afford.features.objects import centres as object_centres
 from afford.sim.camera import CameraConfig, MeshInstance, RangeCamera
 from afford.sim.hand import Hand, HandConfig
 from afford.sim.objects import ObjectSpec, box_mesh, build_object, object_mesh
 
-__all__ = ["TableConfig", "TableWorld", "ObjectTruth"]
+__all__ = ["TableConfig", "TableWorld", "ObjectTruth", "outcome_label", "LIFTED"]
+
+#: Ground truth: an object whose bottom ends this far above the table top was lifted.
+LIFTED = 0.05
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,22 @@ class ObjectTruth:
     quaternion: np.ndarray   # (4,) wxyz
     bottom: float            # lowest point, metres
     in_hand: bool
+
+
+def outcome_label(world: "TableWorld", before: ObjectTruth, after: ObjectTruth, visible: bool) -> int:
+    """The first ground-truth label that applies (index into OUTCOMES)."""
+    top = world.config.table_top
+    if after.position[2] < top:
+        return OUTCOMES.index("fell")
+    if not visible:
+        return OUTCOMES.index("left-view")
+    if after.bottom >= top + LIFTED:
+        return OUTCOMES.index("lifted")
+    moved = float(np.linalg.norm(after.position - before.position))
+    turned = 2 * np.degrees(np.arccos(np.clip(abs(float(np.dot(after.quaternion, before.quaternion))), 0, 1)))
+    if moved >= 0.02 or turned >= 10.0:
+        return OUTCOMES.index("dragged")
+    return OUTCOMES.index("no-change")
 
 
 class TableWorld:
@@ -232,8 +252,6 @@ class TableWorld:
 
     def outcomes(self, before: list[ObjectTruth], after: list[ObjectTruth], perceived: np.ndarray) -> list[int]:
         """Each tracked object's ground-truth outcome (an index into ``features.OUTCOMES``)."""
-        from afford.sim.explore import outcome_label
-
         return [outcome_label(self, a, b, bool(perceived[i, 0])) for i, (a, b) in enumerate(zip(before, after))]
 
     def tracked_truth(self) -> list[ObjectTruth]:

@@ -8,6 +8,8 @@ import pytest
 
 from tests.clitools import fails, ok
 
+BEHAVIOURS = "move-forward, move-left-30, move-right-30, move-left-60, move-right-60, lift"
+
 
 @pytest.fixture(scope="module")
 def explored(tmp_path_factory):
@@ -33,7 +35,7 @@ def test_k_per_behaviour_and_bad_k_in_one_sentence(explored):
     assert out["behaviors"]["lift"]["n_categories"] == 3
     assert out["behaviors"]["move-forward"]["n_categories"] == 6
     msg = fails(["cluster", str(d / "i.afford"), "-o", str(d / "x.afford"), "--k", "jump=3"])
-    assert "no behaviour 'jump'" in msg
+    assert msg.strip().splitlines() == [f"error: there is no behaviour 'jump' to give a k; the behaviours are {BEHAVIOURS}"]
     assert not (d / "x.afford").exists()
     fails(["cluster", str(d / "i.afford"), "-o", str(d / "x.afford"), "--k", "lift=two"], code=2)
 

@@ -58,7 +58,7 @@ def cluster(
         raise typer.BadParameter("--k goes with --method kmeans")
     check_output(output)
     out = Output(json, stdout_busy=writes_stdout(output))
-    with out.progress("clustering effects (behaviours)", None) as update:
+    with out.progress("clustering effects (behaviours)", None, lazy=True) as update:
         result = run(path, output, method=None if method is None else method.value, k_max=kmax, k=ks, prune=prune.value,
                      min_fraction=min_fraction, seed=seed, progress=update)
 

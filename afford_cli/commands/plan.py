@@ -28,6 +28,13 @@ class SearchMethod(str, Enum):
     bfs = "bfs"
 
 
+def _on(obj: int) -> str:
+    """What a step acted on, as a report says it (a behaviour without a target: the scene)."""
+    from afford.plan.forward import SCENE
+
+    return "the scene" if obj == SCENE else f"object {obj}"
+
+
 def render_plan(console, entry: dict, goal_text: list[str]) -> None:
     p = entry["plan"]
     console.print(f"goal: {' and '.join(goal_text)}")
@@ -54,12 +61,12 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
     if entry.get("tree"):
         console.print("search tree, first level (behaviour on object -> category, p, distance to goal):")
         for n in entry["tree"]:
-            console.print(f"  {n['behavior']} on {n['object']} -> {n['category']} p={n['probability']:.2f} d={n['distance']:.2f}")
+            console.print(f"  {n['behavior']} on {_on(n['object'])} -> {n['category']} p={n['probability']:.2f} d={n['distance']:.2f}")
     if "execution" in entry:
         ex = entry["execution"]
         for s in ex["executed"]:
             mark = "[green]as predicted[/]" if s["as_predicted"] else f"[yellow]{s['note']}[/]"
-            console.print(f"  ran {s['behavior']} on {s['object']}: {mark}")
+            console.print(f"  ran {s['behavior']} on {_on(s['object'])}: {mark}")
         verdict = "[green]goal reached[/]" if ex["reached"] else f"[red]not reached[/]: {ex['reason']}"
         extra = f", and {ex['windfalls']} after surprises that helped" if ex.get("windfalls") else ""
         console.print(f"{verdict} (replans: {ex['replans']}{extra})")
