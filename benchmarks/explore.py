@@ -9,7 +9,8 @@ episodes in this process by wrapping each stage. The table: world build, ray cas
 (Open3D), physics (PhysX steps, including contact queries) and features (detection,
 normals, histograms, tracking). The traverse scenes: world build, the scan (720 x 720
 rays cast with Open3D, noise, min-downscale), physics (the robot's moves) and the grid
-features.
+features. ``crane-lift``: the same stages, physics being the moves, the crane's lifts and
+settling, features the background subtraction, segmentation and the 44 features.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from benchmarks._common import emit  # noqa: E402
 
 import afford.features.objects as fobj  # noqa: E402
 import afford.sim.camera as cam  # noqa: E402
+import afford.sim.crane as crane  # noqa: E402
 import afford.sim.moves as moves  # noqa: E402
 import afford.sim.robots.mobile as mobile  # noqa: E402
 import afford.sim.scanner as scanner  # noqa: E402
@@ -119,11 +121,20 @@ def _patched(targets: list[tuple[object, str, str]], totals: dict):
     return saved
 
 
-def traverse_breakdown(scene, episodes: int, seed: int) -> dict:
-    """Where one worker's time goes in a traverse scene, per interaction."""
+#: What to time in each mobile-robot scene: (owner, attribute, stage).
+_STAGES = {
+    "traverse": [(traverse.TraverseWorld, "__init__", "world_build"), (scanner.RangeScanner, "scan", "scan"),
+                 (mobile.MobileRobot, "move", "physics"), (moves, "grid_features", "features")],
+    "crane": [(crane.CraneWorld, "__init__", "world_build"), (scanner.RangeScanner, "scan", "scan"),
+              (mobile.MobileRobot, "move", "physics"), (crane.CraneWorld, "lift", "physics"),
+              (crane.CraneWorld, "settle", "physics"), (crane, "perceive_against", "features")],
+}
+
+
+def scan_breakdown(scene, episodes: int, seed: int) -> dict:
+    """Where one worker's time goes in a mobile-robot scene (Algorithm 1), per interaction."""
     totals = {"world_build": 0.0, "scan": 0.0, "physics": 0.0, "features": 0.0}
-    saved = _patched([(traverse.TraverseWorld, "__init__", "world_build"), (scanner.RangeScanner, "scan", "scan"),
-                      (mobile.MobileRobot, "move", "physics"), (moves, "grid_features", "features")], totals)
+    saved = _patched(_STAGES["crane" if scene.name.startswith("crane") else "traverse"], totals)
     try:
         start = time.perf_counter()
         rows = sum(len(run_episode(scene, seed, e)) for e in range(episodes))
@@ -171,9 +182,9 @@ def breakdown(scene, episodes: int, seed: int) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--interactions", type=int, default=1000, help="per throughput run on the table")
-    ap.add_argument("--traverse-interactions", type=int, default=700, help="per throughput run on a traverse scene")
+    ap.add_argument("--traverse-interactions", type=int, default=700, help="per throughput run on a mobile-robot scene")
     ap.add_argument("--backend-interactions", type=int, default=2000, help="per run comparing loky, Dask and a resume")
-    ap.add_argument("--scenes", default="table,traverse,traverse-body,traverse-ramps,traverse-gaps")
+    ap.add_argument("--scenes", default="table,traverse,traverse-body,traverse-ramps,traverse-gaps,crane-lift")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "explore.json"))
     args = ap.parse_args()
@@ -189,7 +200,7 @@ def main() -> None:
         sc = make_scene(name)
         result[name] = {
             "throughput": [throughput(sc, args.traverse_interactions, w, args.seed) for w in (1, 2)],
-            "breakdown_one_worker": traverse_breakdown(sc, episodes=20, seed=args.seed),
+            "breakdown_one_worker": scan_breakdown(sc, episodes=20, seed=args.seed),
         }
     if "table" not in names:
         emit(result, args.out)

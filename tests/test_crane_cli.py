@@ -50,3 +50,20 @@ def test_a_move_then_lift_plan_is_found_and_reaches_its_goal_in_simulation(explo
     names = [s["behavior"] for s in out["plan"]["steps"]]
     assert names[-1] == "lift" and len(names) >= 2, names
     assert out["execution"]["reached"]
+
+
+def test_the_case_studys_button_is_drawn_on_asking_and_only_where_it_applies(explored):
+    d = explored
+    import afford
+    from afford.sim.scenes.crane_lift import BUTTON
+
+    items = afford.world("crane-lift", seed=3, objects=2, button=True).layout.items
+    assert len(items) == 3 and items[-1].fixed and items[-1].size == BUTTON["size"]
+    assert not any(it.fixed for it in afford.world("crane-lift", seed=3, objects=2).layout.items)
+    out = json.loads(ok(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--seed", "3", "--objects", "2", "--button",
+                         "--goal", "*:r_b>180", "--json"]).stdout)
+    assert 1 <= out["objects"] <= 3
+    from afford.sim.scene import SceneOptionError
+
+    with pytest.raises(SceneOptionError, match="--button does not apply to scene 'table'"):
+        afford.world("table", seed=1, button=True)

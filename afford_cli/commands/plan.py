@@ -86,12 +86,13 @@ def plan(
     max_replans: MaxReplans = 3,
     episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
     reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
+    button: Annotated[bool, typer.Option("--button", help="Add the fixed flat button of thesis 7.6.5 to a drawn scene (crane-lift).")] = False,
     alternatives: Alternatives = 3,
     plot: PlotFile = None,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
-    check_scene_source(layout, seed, objects=objects, reachable=reachable or None,
+    check_scene_source(layout, seed, objects=objects, reachable=reachable or None, button=button or None,
                        episodes=episodes if episodes > 1 else None)
     if plot is not None and episodes > 1:
         raise typer.BadParameter("--plot draws one scene; it does not go with --episodes")
@@ -106,13 +107,13 @@ def plan(
     # a scene the model cannot perceive is refused once, not skipped episode by episode
     loaded.check_schema(make_scene(scene).schema, "this scene's perception")
     if episodes == 1:
-        sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable)
+        sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable, button=button)
         entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives,
                                  say=out.info if execute else None, plot=plot))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
-                sc, specs = scene_layout(scene, base + e, None, objects=objects, reachable=reachable)
+                sc, specs = scene_layout(scene, base + e, None, objects=objects, reachable=reachable, button=button)
                 try:
                     entries.append(plan_once(loaded, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
                 except (AffordError, DataError) as exc:  # e.g. an object hidden behind another
