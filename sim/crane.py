@@ -49,11 +49,11 @@ from scipy.optimize import linear_sum_assignment
 from afford.features import RangeImage
 from afford.features.image_objects import image_object_schema, perceive_against, track_expected
 from afford.sim.camera import MeshInstance
-from afford.sim.objects import SHAPES, box_mesh, build_object, object_mesh
+from afford.sim.objects import SHAPES, box_mesh, object_mesh
 from afford.sim.robots.crane import CraneConfig, CraneRobot, crane_robot_config
 from afford.sim.robots.mobile import MobileRobotConfig, Odometry
 from afford.sim.scanner import RangeScanner, ScannerConfig
-from afford.sim.traverse import TraverseLayout, _plane
+from afford.sim.traverse import TraverseLayout, _plane, build_items
 
 __all__ = ["CraneWorldConfig", "CraneWorld", "CRANE_OUTCOMES", "DRIVE"]
 
@@ -125,18 +125,8 @@ class CraneWorld:
         self.scene.set_timestep(c.timestep)
         floor = sapien.physx.PhysxMaterial(c.floor_friction, c.floor_friction, 0.0)
         self.scene.add_ground(0.0, render=False, material=floor)
-        material = sapien.physx.PhysxMaterial(c.object_friction, c.object_friction, 0.0)
-        self.bodies, self.components = [], []
-        for it in layout.items:
-            body = build_object(self.scene, it.spec, it.bottom, c.density, material)
-            comp = body.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
-            if it.fixed:
-                comp.set_kinematic(True)
-            else:
-                comp.set_max_depenetration_velocity(1.0)
-                comp.set_angular_damping(c.rolling_damping)
-            self.bodies.append(body)
-            self.components.append(comp)
+        self.bodies, self.components = build_items(self.scene, layout.items, c.density, c.object_friction,
+                                                   c.rolling_damping)
         self.robot = CraneRobot(self.scene, c.robot, c.crane)
         self._robot_links = set(self.robot.articulation.get_links())
         self._objects = {comp: i for i, comp in enumerate(self.components)}

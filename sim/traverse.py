@@ -76,7 +76,7 @@ from afford.sim.scanner import RangeScanner, ScannerConfig
 __all__ = [
     "Item", "Ramp", "Gap", "TraverseLayout", "TraverseConfig", "TraverseWorld", "ROTATIONS",
     "sample_clutter", "sample_body", "sample_ramp", "sample_gap",
-    "parse_layout", "layout_toml", "check_layout", "TraverseLayoutFiles",
+    "parse_layout", "layout_toml", "check_layout", "TraverseLayoutFiles", "build_items",
 ]
 
 #: The seven behaviours' rotations, degrees (left positive), right to left.
@@ -588,6 +588,24 @@ class TraverseLayoutFiles:
             raise DataError(f"that is not a layout of scene {self.name!r}")
 
 
+def build_items(scene: sapien.Scene, items, density: float, friction: float, rolling_damping: float):
+    """The layout's objects as rigid bodies on the floor: fixed ones kinematic, loose ones with
+    a little angular damping for rolling resistance. Returns (entities, their components)."""
+    material = sapien.physx.PhysxMaterial(friction, friction, 0.0)
+    bodies, components = [], []
+    for it in items:
+        body = build_object(scene, it.spec, it.bottom, density, material)
+        comp = body.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
+        if it.fixed:
+            comp.set_kinematic(True)
+        else:
+            comp.set_max_depenetration_velocity(1.0)
+            comp.set_angular_damping(rolling_damping)
+        bodies.append(body)
+        components.append(comp)
+    return bodies, components
+
+
 # -- the world --------------------------------------------------------------------------------
 @lru_cache(maxsize=4)
 def _scanner(config: ScannerConfig, origin: tuple[float, float, float]) -> RangeScanner:
@@ -616,19 +634,8 @@ class TraverseWorld:
         self._static: list[MeshInstance] = []
         self._build_floor(floor)
         self.ramps = [self._build_ramp(r, floor) for r in layout.ramps]
-        material = sapien.physx.PhysxMaterial(c.object_friction, c.object_friction, 0.0)
-        self.bodies = []
-        self.components = []
-        for it in layout.items:
-            body = build_object(self.scene, it.spec, it.bottom, c.density, material)
-            comp = body.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent)
-            if it.fixed:
-                comp.set_kinematic(True)
-            else:
-                comp.set_max_depenetration_velocity(1.0)
-                comp.set_angular_damping(c.rolling_damping)
-            self.bodies.append(body)
-            self.components.append(comp)
+        self.bodies, self.components = build_items(self.scene, layout.items, c.density, c.object_friction,
+                                                   c.rolling_damping)
         self.robot = MobileRobot(self.scene, c.robot)
         self.start = self.robot.pose()
         self._item_start = [np.asarray(b.pose.p, dtype=float) for b in self.bodies]
