@@ -67,3 +67,14 @@ def test_the_case_studys_button_is_drawn_on_asking_and_only_where_it_applies(exp
 
     with pytest.raises(SceneOptionError, match="--button does not apply to scene 'table'"):
         afford.world("table", seed=1, button=True)
+
+
+def test_comparison_goals_on_unknown_features_and_bfs_past_its_depth_say_so(explored):
+    d = explored
+    msg = fails(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--seed", "3", "--goal", "*:height>0.5"])
+    assert msg.strip().splitlines()[-1].startswith("error:") and "height" in msg and "Traceback" not in msg
+    out = json.loads(ok(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--seed", "3", "--goal", "*:r_b>400",
+                         "--search", "bfs", "--max-depth", "2", "--json"]).stdout)
+    assert not out["plan"]["found"] and out["plan"]["reason"] == "no plan of at most 2 steps reaches the goal"
+    fails(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--seed", "3", "--goal", "*:r_b>400", "--search", "bfs",
+           "--max-depth", "9"], code=2)
