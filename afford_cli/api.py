@@ -174,7 +174,7 @@ def train(path: str, output: str, *, kernel: str | None = None, folds: int | Non
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
-    from afford.learn.affordances import train_known, train_predictors
+    from afford.learn.affordances import train_known, train_members, train_predictors
     from afford.learning import learner_settings, model_members, read_selection
 
     check_output(output)
@@ -186,8 +186,9 @@ def train(path: str, output: str, *, kernel: str | None = None, folds: int | Non
     predictors = train_predictors(data, labels, selected, kernel=kernel_name, folds=n_folds, seed=seed,
                                   progress=_per_behaviour(progress, data))
     known = train_known(data, labels, seed=seed) if effects is not None else None
+    members = train_members(data, labels, seed=seed) if effects is not None else None
     settings = {"kernel": kernel_name, "folds": n_folds, "selection": art.kind}
-    arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known)
+    arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known, members)
     write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     return {"output": output, "seconds": round(time.perf_counter() - start, 3), "kernel": kernel_name,
             "behaviors": {n: {"cv_accuracy": cv["cv_accuracy"], "best_params": cv["best_params"],
@@ -349,17 +350,24 @@ class Model(LoadedModel):
     categories were discovered, the effect prototypes the planner chains.
 
     Attributes: ``names`` (behaviours), ``schema`` (its ``names`` are the feature names),
-    ``label_source`` (``discovered`` or ``given``), ``result_names``, ``selected``.
+    ``label_source`` (``discovered`` or ``given``), ``result_names``, ``selected``, and
+    ``effect_model``: how :meth:`forward` predicts a category's effect on an entity unless
+    told (``members``, or ``prototype`` for the thesis's; set it to compare).
     """
 
-    def forward(self, min_probability: float = 0.02):
-        """The planner's forward model (outcomes below ``min_probability`` are dropped)."""
+    effect_model = "members"
+
+    def forward(self, min_probability: float = 0.02, effects: str | None = None):
+        """The planner's forward model (outcomes below ``min_probability`` are dropped).
+        ``effects``: ``members`` (each entity's own effect within its category, the default)
+        or ``prototype`` (the thesis's category means); None keeps :attr:`effect_model`."""
+        effects = self.effect_model if effects is None else effects
         cache = self.__dict__.setdefault("_forward", {})
-        if min_probability not in cache:
+        if (min_probability, effects) not in cache:
             from afford.learning import forward_model
 
-            cache[min_probability] = forward_model(self, min_probability=min_probability)
-        return cache[min_probability]
+            cache[min_probability, effects] = forward_model(self, min_probability=min_probability, effects=effects)
+        return cache[min_probability, effects]
 
     def _rows(self, X) -> np.ndarray:
         X = np.atleast_2d(np.asarray(X, dtype=float))
@@ -393,8 +401,9 @@ class Model(LoadedModel):
 
     def predictions(self, state: np.ndarray) -> list[dict]:
         """For each entity of a perceived ``state`` and each behaviour: the probabilities and,
-        where effects are predicted, the most probable category's next entity (what
-        ``afford predict`` reports)."""
+        where effects are predicted, the most probable category's next entity with its
+        spread (the standard deviation of the effects it rests on), as the planner assumes
+        them (what ``afford predict`` reports)."""
         from afford.plan.forward import SCENE
 
         fm = self.forward(min_probability=0.0)
@@ -418,7 +427,10 @@ class Model(LoadedModel):
                         obj = SCENE if fm.behaviors[b].target is None else i
                         cats = [best if j == i else None for j in range(state.shape[0])] if obj == SCENE else best
                         nxt = fm.apply(state, obj, b, cats)[i]
-                        p["next"] = {"visible": bool(schema.visible(nxt)), "features": _named(schema, nxt)}
+                        # how far the members the prediction rests on scattered (the spread of the effect)
+                        spread = fm.spread(f, b, best)
+                        p["next"] = {"visible": bool(schema.visible(nxt)), "features": _named(schema, nxt),
+                                     "spread": _named(schema, spread)}
                     entry["behaviors"][name] = p
             out.append(entry)
         return out

@@ -164,10 +164,11 @@ def result_report(data: Interactions, labels: np.ndarray, b: int) -> list[dict]:
 
 
 def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects: dict | None, selected: dict,
-                  predictors: dict, settings: dict, known: dict | None = None) -> tuple[dict, dict, dict]:
+                  predictors: dict, settings: dict, known: dict | None = None,
+                  members: dict | None = None) -> tuple[dict, dict, dict]:
     from afford.learn.affordances import behaviour_rows, known_columns, parameters_of, predictor_inputs
 
-    arrays, blobs, cv, categories = {}, {}, {}, {}
+    arrays, blobs, cv, categories, member_meta = {}, {}, {}, {}, {}
     for b, name in enumerate(data.behavior_names):
         model = predictors[name]
         rows = behaviour_rows(data, b, labels)
@@ -182,6 +183,9 @@ def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects
         if known and known.get(name) is not None:
             blobs[_blob_name("known", name)] = dump_estimator(known[name])
             arrays[f"known_selected.{name}"] = known_columns(data.schema).astype(np.int16)
+        if members and members.get(name) is not None:
+            parts, member_meta[name] = members[name].to_arrays()
+            arrays.update({f"members_{part}.{name}": a for part, a in parts.items()})
         cv[name] = model.cv_report_
         categories[name] = (category_report(data, labels, b, effects[name].prototypes_) if effects is not None
                             else result_report(data, labels, b))
@@ -197,6 +201,8 @@ def model_members(art: Artifact, data: Interactions, labels: np.ndarray, effects
         "cv": cv,
         "categories": categories,
     }
+    if member_meta:
+        meta["member_effects"] = member_meta
     return arrays, meta, blobs
 
 
@@ -257,6 +263,30 @@ class LoadedModel:
             if cats is not None and len(cats) != expected:
                 raise AffordError(f"{art.source} is corrupt or was edited: its manifest lists {len(cats)} categories "
                                   f"of {n}, its arrays {expected}")
+        self.members = {n: self._members(art, n) for n in self.names}
+
+    def _members(self, art: Artifact, name: str):
+        """Behaviour ``name``'s member effects (None in models from before they existed)."""
+        from afford.learn.members import MemberEffects
+
+        meta = art.manifest.get("member_effects", {})
+        if not isinstance(meta, dict) or name not in meta:
+            return None
+        parts = {part: art.arrays.get(f"members_{part}.{name}") for part in ("Z", "E", "labels", "shift", "weight")}
+        try:
+            if any(a is None for a in parts.values()) or not isinstance(meta[name], dict):
+                raise ValueError("parts are missing")
+            members = MemberEffects.from_arrays(parts, meta[name])
+        except ValueError:
+            raise AffordError(f"{art.source}: the member effects of {name} do not fit together; "
+                              "it is corrupt or was edited") from None
+        d = len(self.schema)
+        width = d + sum(2 if p.get("periodic") else 1 for p in self.parameters(name))
+        if members.Z_.shape[1] != width or members.E_.shape[1] != d or (
+                members.labels_.size and members.labels_.max() >= self.prototypes[name].shape[0]):
+            raise AffordError(f"{art.source}: the member effects of {name} do not match its schema and categories; "
+                              "it is corrupt or was edited")
+        return members
 
     def parameters(self, name: str) -> list[dict]:
         return list(self.behaviors[self.names.index(name)].get("parameters", []))
@@ -280,8 +310,9 @@ def load_model(path: str):
     return Model(read_artifact(path, "model"))
 
 
-def forward_model(model: LoadedModel, min_probability: float = 0.02):
-    """The planner's forward model of a loaded model artefact."""
+def forward_model(model: LoadedModel, min_probability: float = 0.02, effects: str = "members"):
+    """The planner's forward model of a loaded model artefact (``effects``: ``members`` or
+    ``prototype``, :class:`afford.plan.forward.ForwardModel`)."""
     from afford.plan.forward import BehaviorModel, ForwardModel
 
     behaviors = []
@@ -291,5 +322,5 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02):
         behaviors.append(BehaviorModel(name, model.predictors[name], model.selected[name], model.prototypes[name], params,
                                        known=model.known[name], known_selected=model.known_selected[name],
                                        periodic=tuple(bool(p.get("periodic")) for p in spec.get("parameters", [])),
-                                       target=spec.get("target", "object")))
-    return ForwardModel(behaviors, model.schema, min_probability=min_probability)
+                                       target=spec.get("target", "object"), members=model.members[name]))
+    return ForwardModel(behaviors, model.schema, min_probability=min_probability, effects=effects)

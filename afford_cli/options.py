@@ -8,7 +8,8 @@ from typing import Annotated, Optional
 import typer
 
 __all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives", "SceneSeed", "Objects",
-           "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source", "Kernel", "KernelOption"]
+           "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source", "Kernel", "KernelOption",
+           "EffectModel", "Effects"]
 
 Seed = Annotated[int, typer.Option("--seed", "-s", min=0, help="Random seed: the same seed gives the same arrays (whatever --workers is, where a command has workers).")]
 Workers = Annotated[int, typer.Option("--workers", "-w", min=1, max=64, help="Parallel worker processes.")]
@@ -28,6 +29,16 @@ class Kernel(str, Enum):
 
 KernelOption = Annotated[Optional[Kernel], typer.Option(
     "--kernel", help="SVM kernel; by default the scene's (linear for the traverse scenes, as in thesis chapter 5; RBF at the table).")]
+
+
+class EffectModel(str, Enum):
+    members = "members"
+    prototype = "prototype"
+
+
+Effects = Annotated[EffectModel, typer.Option(
+    "--effects", help="How a category's effect on an object is predicted: from the category's members most like it "
+                      "(members), or the category's mean for every object (prototype, the thesis's model).")]
 
 
 # -- where a command acts: a drawn scene or a pinned layout, and the planner's limits ------

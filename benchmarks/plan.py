@@ -95,6 +95,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--crane-episodes", type=int, default=300, help="crane-lift episodes to learn from (0: skip the crane)")
     ap.add_argument("--crane-layouts", type=int, default=10)
+    ap.add_argument("--effects", default="members", choices=["members", "prototype"],
+                    help="the forward model's effects (members: each object's own; prototype: the thesis's)")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "plan.json"))
     args = ap.parse_args()
     t = time.perf_counter()
@@ -116,6 +118,7 @@ def main() -> None:
     except Exception:  # the extra is not installed: no comparison
         pddl = False
     model = load_model(model_path)
+    model.effect_model = args.effects
     goals = {
         "all three gone": ["0:visibility=0", "1:visibility=0", "2:visibility=0"],
         "object 0 pushed 20 cm away": None,  # filled per scene
@@ -129,20 +132,20 @@ def main() -> None:
         x = state[0, model.schema.index("x_min")]
         for name, exprs in goals.items():
             exprs = exprs or [f"0:x_min={x + 0.2:.3f}~0.06"]
-            fm = forward_model(model)  # a fresh cache: every plan pays for its own predictions
+            fm = forward_model(model, effects=args.effects)  # a fresh cache: every plan pays for its own predictions
             goal = parse_goal(exprs, model.schema)
             plan = best_first(fm, state, goal, max_depth=5, max_nodes=20000)
             t0 = time.perf_counter()
             assess(fm, state, goal, plan, max_depth=5, max_nodes=20000)  # what `afford plan` adds
             assess_s = time.perf_counter() - t0
             t0 = time.perf_counter()
-            rank_plans(forward_model(model), state, goal, 3, max_depth=5, max_nodes=20000)  # --alternatives 3
+            rank_plans(forward_model(model, effects=args.effects), state, goal, 3, max_depth=5, max_nodes=20000)  # --alternatives 3
             row = {"goal": name, "found": plan.found, "length": len(plan.steps), "seconds": plan.seconds,
                    "assess_seconds": assess_s, "rank3_seconds": time.perf_counter() - t0,
                    "expanded": plan.expanded, "generated": plan.generated, "predictions": fm.predictions}
             if pddl:
                 t0 = time.perf_counter()
-                task = build_task(forward_model(model), state, goal, max_depth=5)
+                task = build_task(forward_model(model, effects=args.effects), state, goal, max_depth=5)
                 row["pddl_write_seconds"] = time.perf_counter() - t0
                 fd = solve_pddl(task)
                 row.update(fd_found=fd["solved"], fd_length=len(fd["steps"]), fd_seconds=fd["seconds"],
@@ -159,6 +162,7 @@ def main() -> None:
     nodes = np.array([r["expanded"] for r in rows])
     result = {
         "benchmark": "plan",
+        "effects": args.effects,
         "model_build_seconds": build_s,
         "plans": len(rows),
         "found": int(sum(r["found"] for r in rows)),

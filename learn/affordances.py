@@ -27,7 +27,7 @@ from afford.learn.relevance import FeatureRelevance, feature_groups
 
 __all__ = [
     "MIN_ROWS", "behaviour_rows", "predictor_inputs", "discover_effects", "rank_features", "train_predictors",
-    "behaviour_seed", "known_columns", "train_known", "parameters_of",
+    "behaviour_seed", "known_columns", "train_known", "train_members", "parameters_of",
 ]
 
 #: Fewest interactions of one behaviour worth learning from.
@@ -173,6 +173,30 @@ def train_known(data: Interactions, labels: np.ndarray, *, seed: int = 0, min_ro
             continue
         X = predictor_inputs(data.before_rows(rows), data.params[rows], known_columns(data.schema), parameters_of(data, b))
         out[name] = AffordancePredictor(kernel="rbf", calibration="sigmoid", random_state=behaviour_seed(seed, b)).fit(X, known)
+    return out
+
+
+def train_members(data: Interactions, labels: np.ndarray, *, seed: int = 0) -> dict:
+    """Per behaviour, each entity's own effect within its category (:class:`MemberEffects`).
+
+    It reads every entity feature (:func:`known_columns`) and the behaviour's parameters:
+    how far a push moves an object depends on its width, which the features chosen to tell
+    the categories apart need not include. Behaviours without kept rows get none (``None``).
+    """
+    from afford.learn.members import MemberEffects
+
+    out: dict = {}
+    cols = known_columns(data.schema)
+    for b, name in enumerate(data.behavior_names):
+        rows = behaviour_rows(data, b, labels)
+        if rows.size == 0:
+            out[name] = None
+            continue
+        params = parameters_of(data, b)
+        X = predictor_inputs(data.before_rows(rows), data.params[rows], cols, params)
+        groups = [data.schema.channels[i] for i in cols] + ["parameters"] * (X.shape[1] - cols.size)
+        out[name] = MemberEffects(groups, data.schema.channels, data.schema.tolerances,
+                                  random_state=behaviour_seed(seed, b)).fit(X, data.effects_of(rows), labels[rows])
     return out
 
 

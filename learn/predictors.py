@@ -372,6 +372,54 @@ class _Margins(ClassifierMixin, BaseEstimator):
         return D[:, 0] if D.shape[1] == 1 else D
 
 
+def _calibration(c0, estimator_classes):
+    """``margins -> probabilities`` of a fitted sigmoid or temperature calibration, in numpy:
+    the arithmetic of scikit-learn's ``_CalibratedClassifier.predict_proba`` (1.9) without its
+    per-call validation (None for any other method)."""
+    from scipy.special import expit, softmax
+
+    classes = np.asarray(c0.classes)
+    n = classes.size
+    if c0.method == "sigmoid":
+        idx = np.searchsorted(np.sort(classes), np.asarray(estimator_classes))
+        if n == 2:
+            idx = idx + 1
+        ab = [(float(c.a_), float(c.b_)) for c in c0.calibrators]
+
+        def sigmoid(D):
+            D = D.reshape(len(D), -1)
+            proba = np.zeros((len(D), n))
+            for j, (a, b), col in zip(idx, ab, D.T):
+                proba[:, j] = expit(-(a * col + b))
+            if n == 2:
+                proba[:, 0] = 1.0 - proba[:, 1]
+            else:
+                den = proba.sum(axis=1)[:, None]
+                proba = np.divide(proba, den, out=np.full_like(proba, 1.0 / n), where=den != 0)
+            proba[(1.0 < proba) & (proba <= 1.0 + 1e-5)] = 1.0
+            return proba
+
+        return sigmoid
+    if c0.method == "temperature":
+        beta = float(c0.calibrators[0].beta_)
+
+        def temperature(D):
+            D = np.asarray(D, dtype=np.float64)
+            if D.ndim == 1 or D.shape[1] == 1:
+                d = D.reshape(-1)
+                logits = np.column_stack([-d, d])
+            elif np.all((D >= 0) & (D <= 1)) and np.all(np.isclose(D.sum(axis=1), 1.0)):
+                logits = np.log(D + 1e-12)  # scikit-learn reads such margins as probabilities
+            else:
+                logits = D
+            proba = softmax(beta * logits, axis=1)
+            proba[(1.0 < proba) & (proba <= 1.0 + 1e-5)] = 1.0
+            return proba
+
+        return temperature
+    return None
+
+
 def fast_predict_proba(predictor: AffordancePredictor):
     """A function ``X -> predict_proba(X)`` for repeated calls on a few rows at a time.
 
@@ -380,21 +428,27 @@ def fast_predict_proba(predictor: AffordancePredictor):
     anything else falls back to ``predict_proba``. Inputs are not validated: the caller
     passes finite rows of the right width.
     """
-    from sklearn.calibration import _CalibratedClassifier
-
     check_is_fitted(predictor)
     cc = predictor.calibrated_
     pipe = cc.calibrated_classifiers_[0].estimator if not cc.ensemble else None
     if pipe is None or not isinstance(pipe.named_steps.get("svc"), OneVsRestClassifier):
         return predictor.predict_proba
     c0 = cc.calibrated_classifiers_[0]
-    fast = _CalibratedClassifier(_Margins(pipe).fit(), c0.calibrators, classes=c0.classes, method=c0.method)
+    margins = _Margins(pipe).fit()
+    calibrate = _calibration(c0, margins.classes_)
+    if calibrate is None:  # a calibration this does not know: scikit-learn's own
+        from sklearn.calibration import _CalibratedClassifier
+
+        calibrate = _CalibratedClassifier(margins, c0.calibrators, classes=c0.classes, method=c0.method).predict_proba
+        decide = lambda X: X  # noqa: E731
+    else:
+        decide = margins.decision_function
     columns = cc.classes_
     n_classes = predictor.classes_.size
 
     def proba(X):
         out = np.zeros((len(X), n_classes))
-        out[:, columns] = fast.predict_proba(X)
+        out[:, columns] = calibrate(decide(X))
         return out
 
     return proba

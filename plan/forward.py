@@ -1,8 +1,12 @@
 """The forward model: what the robot expects its behaviours to do (thesis 8.6).
 
 For an object f, a behaviour b and its parameters alpha, the predictor gives P(E | f, b,
-alpha) over b's effect categories; the next state of that object is f + prototype(E), and
-no other object changes (chapter 8). Where the model also learned P(known | f, b, alpha),
+alpha) over b's effect categories; the next state of that object is f plus the effect
+category E has on f, and no other object changes (chapter 8). That effect is, by default,
+the mean effect of the members of E whose entities looked most like f
+(:class:`afford.learn.members.MemberEffects`), and a sampled rollout draws one of those
+members' effects; ``effects="prototype"`` gives the thesis's model, f + prototype(E), for
+every member alike (models trained before member effects existed have only that). Where the model also learned P(known | f, b, alpha),
 the chance that the effect is of a kind its categories kept at all, the category
 probabilities are multiplied by it: the rest is an unknown outcome, which no plan counts on. An object that the prototype makes vanish keeps its
 last seen position and shape with visibility 0, as perception does.
@@ -21,7 +25,10 @@ import numpy as np
 from afford.features import encode_parameters
 from afford.features.errors import DataError
 
-__all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE"]
+__all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE", "EFFECT_MODELS"]
+
+#: How a category's effect on one entity is predicted (``ForwardModel(effects=...)``).
+EFFECT_MODELS = ("members", "prototype")
 
 
 #: The object index a step on a behaviour without a target carries: it acts on the scene.
@@ -41,6 +48,7 @@ class BehaviorModel:
     known_selected: np.ndarray | None = None  # the columns ``known`` reads (None: ``selected``)
     periodic: tuple[bool, ...] = ()    # which parameters are angles (encoded as sine and cosine)
     target: str | None = "object"      # None: the behaviour acts on no one object; every row may change
+    members: object | None = None      # MemberEffects: each entity's own effect within a category
 
 
 @dataclass(frozen=True)
@@ -79,6 +87,9 @@ class ForwardModel:
         Rise (metres) of the height feature that means an object is held.
     height : int or None
         Overrides the schema's ``height`` role.
+    effects : {"members", "prototype"}
+        How a category's effect on an entity is predicted: from the category's members most
+        like it (where the model has them), or the category's prototype for all (the thesis).
 
     A behaviour whose ``target`` is None acts on the whole scene: every visible row changes
     by its own predicted effect, and an outcome is one category per row (its probability
@@ -86,8 +97,12 @@ class ForwardModel:
     """
 
     def __init__(self, behaviors: list[BehaviorModel], schema, min_probability: float = 0.02,
-                 param_steps: int = 5, raised: float = 0.05, height: int | None = None):
+                 param_steps: int = 5, raised: float = 0.05, height: int | None = None,
+                 effects: str = "members"):
+        if effects not in EFFECT_MODELS:
+            raise DataError(f"unknown effect model {effects!r}; choose {' or '.join(EFFECT_MODELS)}")
         self.behaviors = behaviors
+        self.effects = effects
         self.schema = schema
         self.visibility = schema.visibility_index
         self.height = height if height is not None else schema.role("height")
@@ -97,6 +112,7 @@ class ForwardModel:
         self.min_probability = min_probability
         self.param_steps = param_steps
         self._cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
+        self._effect_cache: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}
         self._fast: dict[int, object] = {}
         self.predictions = 0
 
@@ -177,6 +193,11 @@ class ForwardModel:
                 for v, p in zip(todo, proba):
                     self._cache[(b, v.tobytes(), alpha)] = (classes, p)
                 self.predictions += len(todo)
+                if self.effects == "members" and model.members is not None and model.prototypes is not None:
+                    # every category's effect on each new vector, in the same batch
+                    means, known = model.members.means(np.stack([self._member_input(model, v, alpha) for v in todo]))
+                    for v, m in zip(todo, means):
+                        self._effect_cache[(b, v.tobytes(), alpha)] = (m, known)
 
     def in_hand(self, before: np.ndarray, after: np.ndarray, obj: int) -> bool:
         """Did acting on ``obj`` leave it in the hand? Its height feature rose by more than ``raised``.
@@ -189,13 +210,58 @@ class ForwardModel:
             return False
         return bool(after[obj, self.height] - before[obj, self.height] > self.raised)
 
-    def _moved(self, before: np.ndarray, b: int, category: int) -> np.ndarray:
-        """Entity ``before`` after category ``category`` of behaviour ``b`` (vanished: last seen, visibility 0)."""
-        prototypes = self.behaviors[b].prototypes
-        if prototypes is None:
+    def _members(self, b: int, category: int):
+        """Behaviour ``b``'s member effects, where they are used and know ``category``."""
+        members = self.behaviors[b].members
+        if self.effects == "members" and members is not None and members.has(category):
+            return members
+        return None
+
+    def _member_input(self, model: BehaviorModel, f: np.ndarray, alpha: tuple) -> np.ndarray:
+        return np.concatenate([f, self._alpha_columns(model, alpha)])
+
+    def effect(self, f: np.ndarray, b: int, category: int, alpha: tuple = ()) -> np.ndarray:
+        """The effect category ``category`` of behaviour ``b`` is predicted to have on entity
+        ``f``: with member effects, the mean of the effects of the category's members most
+        like ``f`` (every category's at once, cached by ``f``'s bytes); else the prototype."""
+        model = self.behaviors[b]
+        if model.prototypes is None:
             raise DataError(f"behaviour {self.names[b]!r} has no effect prototypes (its labels were given), "
-                             "so the next state cannot be predicted")
-        f = before + prototypes[category]
+                            "so the next state cannot be predicted")
+        if self.effects != "members" or model.members is None:
+            return model.prototypes[category]
+        key = (b, f.tobytes(), alpha)
+        hit = self._effect_cache.get(key)
+        if hit is None:
+            means, known = model.members.means(self._member_input(model, f, alpha))
+            hit = self._effect_cache[key] = (means, known)
+        means, known = hit
+        return means[category] if category < known.size and known[category] else model.prototypes[category]
+
+    def spread(self, f: np.ndarray, b: int, category: int, alpha: tuple = ()) -> np.ndarray:
+        """How far the effects :meth:`effect` rests on scatter (standard deviation per feature):
+        the nearest members' (members), or every member's of the category (prototype);
+        zeros where the model keeps no members."""
+        members = self.behaviors[b].members
+        if members is None or not members.has(category):
+            return np.zeros(len(self.schema))
+        if self.effects == "members":
+            return members.predict(self._member_input(self.behaviors[b], f, alpha), category)[1]
+        return members.category_spread(category)
+
+    def draw_effect(self, f: np.ndarray, b: int, category: int, alpha: tuple, rng: np.random.Generator) -> np.ndarray:
+        """One effect of category ``category`` on ``f`` as a world might give it: one of the
+        nearest members' own effects (the prototype, without member effects)."""
+        members = self._members(b, category)
+        if members is None:
+            return self.effect(f, b, category, alpha)
+        effects = members.effects(self._member_input(self.behaviors[b], f, alpha), category)
+        return effects[int(rng.integers(len(effects)))]
+
+    def _moved(self, before: np.ndarray, b: int, category: int, alpha: tuple = (),
+               effect: np.ndarray | None = None) -> np.ndarray:
+        """Entity ``before`` after category ``category`` of behaviour ``b`` (vanished: last seen, visibility 0)."""
+        f = before + (self.effect(before, b, category, alpha) if effect is None else effect)
         v = self.visibility
         if v is not None and f[v] < 0.5:
             out = before.copy()
@@ -209,19 +275,21 @@ class ForwardModel:
             f[h] = bins / total if total > 0 else before[h]
         return f
 
-    def apply(self, state: np.ndarray, obj: int, b: int, category) -> np.ndarray:
-        """The state after behaviour ``b`` on ``obj`` produced ``category``.
+    def apply(self, state: np.ndarray, obj: int, b: int, category, alpha: tuple = (), effects=None) -> np.ndarray:
+        """The state after behaviour ``b`` (parameters ``alpha``) on ``obj`` produced ``category``.
 
         For a behaviour without a target (``obj`` is :data:`SCENE`), ``category`` holds one
-        category per row (None for a row left as it is: an unseen one).
+        category per row (None for a row left as it is: an unseen one). ``effects``: the
+        effect to add instead of the predicted one (one per row for :data:`SCENE`), as a
+        sampled rollout draws it.
         """
         nxt = state.copy()
         if obj == SCENE:
             for i, c in enumerate(category):
                 if c is not None:
-                    nxt[i] = self._moved(state[i], b, int(c))
+                    nxt[i] = self._moved(state[i], b, int(c), alpha, None if effects is None else effects[i])
             return nxt
-        nxt[obj] = self._moved(state[obj], b, int(category))
+        nxt[obj] = self._moved(state[obj], b, int(category), alpha, effects)
         return nxt
 
     def outcomes(self, state: np.ndarray, obj: int, b: int, alpha: tuple = (), floor: float | None = None) -> list[Outcome]:
@@ -233,7 +301,7 @@ class ForwardModel:
             return []  # the robot cannot act on what it does not see
         classes, proba = self.distribution(state[obj], b, alpha)
         order = np.argsort(-proba, kind="stable")
-        return [Outcome(int(classes[i]), float(proba[i]), self.apply(state, obj, b, int(classes[i])))
+        return [Outcome(int(classes[i]), float(proba[i]), self.apply(state, obj, b, int(classes[i]), alpha))
                 for i in order if proba[i] >= floor]
 
     def _scene_outcomes(self, state: np.ndarray, b: int, alpha: tuple, floor: float) -> list[Outcome]:
@@ -251,6 +319,6 @@ class ForwardModel:
             cats: list = [None] * state.shape[0]
             for i, (c, _) in zip(rows, combo):
                 cats[i] = c
-            out.append(Outcome(tuple(cats), p, self.apply(state, SCENE, b, cats)))
+            out.append(Outcome(tuple(cats), p, self.apply(state, SCENE, b, cats, alpha)))
         out.sort(key=lambda o: -o.probability)
         return out

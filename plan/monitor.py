@@ -194,26 +194,32 @@ class _Imagined:
         return self.state.copy()
 
     def _fate(self, f: np.ndarray, b: int, alpha: tuple):
-        """The category this world holds for behaviour ``b`` on entity ``f`` (None: unknown kind)."""
+        """(category, effect) this world holds for behaviour ``b`` on entity ``f`` (None: an
+        unknown kind): the category drawn from the model's distribution, the effect from
+        those the category's members most like ``f`` had (:meth:`ForwardModel.draw_effect`)."""
         key = (f.tobytes(), b, alpha)
         if key not in self.fate:
             classes, proba = self.model.distribution(f, b, alpha)
             edges = np.cumsum(proba)
             r = self.rng.random()
-            self.fate[key] = int(classes[min(np.searchsorted(edges, r, side="right"), len(classes) - 1)]) \
-                if edges.size and r < edges[-1] else None
+            if edges.size and r < edges[-1]:
+                c = int(classes[min(np.searchsorted(edges, r, side="right"), len(classes) - 1)])
+                self.fate[key] = (c, self.model.draw_effect(f, b, c, alpha, self.rng))
+            else:
+                self.fate[key] = None
         return self.fate[key]
 
     def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:
         b = self.model.index(behavior)
         alpha_key = tuple(float(a) for a in (() if alpha is None else alpha))
         if target == SCENE:  # every seen row meets its own fate
-            cats = [self._fate(f, b, alpha_key) if self.model.visible(f) else None for f in self.state]
-            self.state = self.model.apply(self.state, SCENE, b, cats)
+            fates = [self._fate(f, b, alpha_key) if self.model.visible(f) else None for f in self.state]
+            self.state = self.model.apply(self.state, SCENE, b, [None if x is None else x[0] for x in fates], alpha_key,
+                                          effects=[None if x is None else x[1] for x in fates])
             return self.perceive()
         fate = self._fate(self.state[target], b, alpha_key)
         if fate is not None and self.model.visible(self.state[target]):
-            self.state = self.model.apply(self.state, target, b, fate)
+            self.state = self.model.apply(self.state, target, b, fate[0], alpha_key, effects=fate[1])
         return self.perceive()
 
 

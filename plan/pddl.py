@@ -1,7 +1,8 @@
 """A learned model as PDDL, for off-the-shelf planners (Fast Downward through unified-planning).
 
 afford plans in the robot's perceptual space: an object is a feature vector, and a
-behaviour's effect category moves it by the category's prototype (:mod:`plan.forward`).
+behaviour's effect category moves it by the effect the forward model predicts for that
+category and object (:mod:`plan.forward`: its most similar members' mean, or the prototype).
 PDDL wants finite symbols, so the vectors the model can reach become them:
 
 * **Situations.** From each perceived object, the forward model is chained breadth-first
@@ -9,7 +10,7 @@ PDDL wants finite symbols, so the vectors the model can reach become them:
   to the centimetre are one, as in the search). An object is ``(at ?o ?s)`` in one of them.
 * **Discretised feature predicates.** Static facts about situations: ``(visible ?s)``, and
   one predicate per goal condition (``(x_min-above-0p15 ?s)``: feature ``x_min`` of that
-  situation is above 0.15), true where the prototype arithmetic puts the vector there.
+  situation is above 0.15), true where the forward model puts the vector there.
 * **Operators.** In the deterministic domain, one operator per (behaviour, category), with
   the static relation ``(likely-b-cK ?from ?to)`` listing where the category is the behaviour's
   most likely outcome: the model determinised at its most likely outcome. Each step costs
@@ -238,9 +239,9 @@ def _hand(raises: bool) -> str:
 
 
 def _operators(fm: ForwardModel, edges: list[_Edge]) -> dict[str, tuple[int, int, bool]]:
-    """Operator name -> (behaviour, category, raises). A category moves its object by one
-    prototype, so whether it raises the object is the category's; should one category both
-    raise and not (it cannot, by the arithmetic), it gets an operator for each."""
+    """Operator name -> (behaviour, category, raises). Whether a step raises its object is
+    mostly the category's; should one category both raise and not (its members' effects
+    differ from object to object), it gets an operator for each."""
     kinds = {(e.behavior, e.category, e.raises) for e in edges}
     ops = {}
     for b, c, r in sorted(kinds):

@@ -77,6 +77,45 @@ def test_predict_proba_is_what_afford_predict_reports(pipeline):
             assert p["next"]["features"] == {model.schema.names[j]: round(float(nxt[j]), 4) for j in model.schema.geometry}
 
 
+def test_predict_effects_option_chooses_the_members_or_the_prototype(pipeline):
+    """--effects prototype moves an object by its category's mean; members (the default)
+    by the mean of the nearest members' own effects, with their spread beside it."""
+    model = afford.load_model(str(pipeline / "model.afford"))
+    state = afford.world("table", seed=2, objects=2).perceive()
+    geometry = model.schema.geometry
+    moved = 0
+    for effects in ("members", "prototype"):
+        out = json.loads(runner.invoke(app, ["predict", str(pipeline / "model.afford"), "--seed", "2", "--objects", "2",
+                                             "--effects", effects, "--json"]).stdout)
+        for entry in out["objects"]:
+            i = entry["object"]
+            for name, p in entry["behaviors"].items():
+                if not p["next"]["visible"]:
+                    continue
+                members = model.members[name]
+                c = p["category"]
+                if effects == "prototype":
+                    effect = model.prototypes[name][c]
+                else:
+                    effect = members.E_[members.neighbours(state[i], c)].astype(float).mean(axis=0)
+                    spread = members.E_[members.neighbours(state[i], c)].astype(float).std(axis=0)
+                    assert p["next"]["spread"] == {model.schema.names[j]: round(float(spread[j]), 4) for j in geometry}
+                want = state[i] + effect
+                for j in geometry:
+                    assert p["next"]["features"][model.schema.names[j]] == pytest.approx(want[j], abs=2e-4)
+                moved += effects == "members" and bool(np.abs(effect - model.prototypes[name][c])[geometry].max() > 0.005)
+    assert moved  # somewhere the members predict another move than the prototype
+
+
+def test_evaluate_scores_where_both_forward_models_put_things(pipeline):
+    out = json.loads(runner.invoke(app, ["evaluate", str(pipeline / "model.afford"), str(pipeline / "test.afford"),
+                                         "--json"]).stdout)
+    errors = [m["effect_error"]["position"] for m in out["behaviors"].values()]
+    assert all(e["n"] > 0 for e in errors)
+    # within-category precision: over the behaviours, the members err less at the median
+    assert sum(e["members"]["median_cm"] for e in errors) < sum(e["prototype"]["median_cm"] for e in errors)
+
+
 def test_a_feature_vector_of_the_wrong_length_is_one_sentence(pipeline):
     model = afford.load_model(str(pipeline / "model.afford"))
     with pytest.raises(afford.AffordError, match="give feature vectors of 43 features"):

@@ -296,6 +296,15 @@ def _cases(p: Path):
          ["predict", "--seed", "1"]),
         ("edited-counts", "train.afford", {}, lambda m: m.update(n_interactions=9999, n_episodes=-3), ["inspect"]),
         ("missing-member", "model.afford", {"selected.push-forward.npy": None}, None, ["predict", "--seed", "1"]),
+        ("member-effects-short", "model.afford", {"members_E.lift.npy": _npy(np.zeros((3, 43), np.float32))}, None,
+         ["predict", "--seed", "1"]),
+        ("member-effects-missing", "model.afford", {"members_Z.push-left.npy": None}, None,
+         ["plan", "--seed", "1", "--goal", "*:visibility=0"]),
+        ("member-effects-category", "model.afford",
+         {"members_labels.lift.npy": _npy(np.full(model.arrays["members_labels.lift"].shape, 99, np.int16))}, None,
+         ["predict", "--seed", "1"]),
+        ("member-effects-meta", "model.afford", {}, lambda m: m["member_effects"]["lift"].update(k="many"),
+         ["predict", "--seed", "1"]),
     ]
 
 
@@ -313,7 +322,7 @@ def forged(pipeline, tmp_path_factory):
     "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot", "nested-swap",
     "train-x-shape", "predictor-swapped-between-behaviours", "categories-count", "prototypes-strings",
     "edited-counts",
-    "missing-member"])
+    "missing-member", "member-effects-short", "member-effects-missing", "member-effects-category", "member-effects-meta"])
 def test_a_forged_file_is_one_sentence_and_exit_1(forged, pipeline, tmp_path, case):
     from typer.testing import CliRunner
 

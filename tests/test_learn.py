@@ -427,8 +427,11 @@ def test_fast_probabilities_equal_predict_proba(kernel):
     fast = fast_predict_proba(model)
     Xt = rng.normal(size=(30, 4))
     assert np.allclose(fast(Xt), model.predict_proba(Xt), atol=1e-9)
-    binary = AffordancePredictor(calibration="sigmoid", random_state=0).fit(X, (X[:, 2] > 0).astype(int))
-    assert np.allclose(fast_predict_proba(binary)(Xt), binary.predict_proba(Xt), atol=1e-9)
+    for calibration in ("sigmoid", "temperature"):
+        binary = AffordancePredictor(calibration=calibration, random_state=0).fit(X, (X[:, 2] > 0).astype(int))
+        assert np.allclose(fast_predict_proba(binary)(Xt), binary.predict_proba(Xt), atol=1e-9)
+    multi = AffordancePredictor(calibration="sigmoid", random_state=0).fit(X, y)
+    assert np.allclose(fast_predict_proba(multi)(Xt), multi.predict_proba(Xt), atol=1e-9)
 
 
 def test_grid_choice_best_or_smoothest_within_one_standard_error():

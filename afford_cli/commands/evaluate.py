@@ -12,6 +12,7 @@ from afford.datasets import interactions_from_artifact
 from afford.errors import AffordError
 from afford.learning import load_model
 from afford.options import Json, Seed
+from afford.plan.forward import SCENE
 from afford.output import Output
 from afford.plots import PlotDir, evaluation_plots, plot_directory, written
 from afford.reports import render_metrics
@@ -60,6 +61,8 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
         }
         entry["label_names"] = _label_names(model, name, m["labels"])
         entry.update(_open_set(model, name, data, rows, X, y, predictor))
+        if model.label_source != "given":
+            entry["effect_error"] = effect_error(model, name, data, rows)
         if baselines:
             arrays = model.art.arrays
             entry["baselines"] = baseline_scores(arrays[f"train_X.{name}"], arrays[f"train_y.{name}"].astype(int),
@@ -77,6 +80,48 @@ def _label_names(model, name: str, labels) -> dict[str, str]:
         return {str(int(c)): model.result_names[int(c)] for c in labels}
     cats = {int(c["id"]): c for c in model.art.manifest.get("categories", {}).get(name, [])}
     return {str(int(c)): category_name(cats[int(c)].get("prototype", {})) if int(c) in cats else "?" for c in labels}
+
+
+def effect_error(model, name: str, data, rows: np.ndarray) -> dict:
+    """Per channel in metres: how far the predicted next entity lies from the perceived one,
+    for the member-effect forward model and the thesis's prototype one.
+
+    The prediction is the planner's main branch: the most probable category's next state
+    (:meth:`afford.plan.forward.ForwardModel.apply`). The error of a row is the root mean
+    square, over the channel's features, of predicted minus perceived, in centimetres;
+    rows where the entity was unseen before or after are left out. ``median_cm`` and
+    ``p90_cm`` per model, and ``n``.
+    """
+    schema = model.schema
+    channels = [c.name for c in schema.channel_info if c.unit == "m" and c.name in schema.channel_names]
+    before = data.before_rows(rows).astype(float)
+    after = before + data.effects_of(rows)
+    seen = np.array([schema.visible(f) and schema.visible(g) for f, g in zip(before, after)], dtype=bool)
+    out: dict = {}
+    if not channels or not seen.any():
+        return out
+    predicted = {}
+    for effects in ("members", "prototype"):
+        fm = model.forward(min_probability=0.0, effects=effects)
+        b = fm.index(name)
+        target = SCENE if fm.behaviors[b].target is None else 0
+        if not model.parameters(name):
+            fm.prefetch(list(before[seen]), only=b, alpha_only=())
+        nxt = []
+        for f, alpha in zip(before[seen], data.params[rows][seen]):
+            alpha = tuple(float(a) for a in alpha)
+            classes, proba = fm.distribution(f, b, alpha)
+            best = int(classes[np.argmax(proba)])
+            nxt.append(fm.apply(f[None, :], target, b, [best] if target == SCENE else best, alpha)[0])
+        predicted[effects] = np.asarray(nxt)
+    for channel in channels:
+        cols = schema.channel_indices(channel)
+        entry = {"n": int(seen.sum())}
+        for effects, nxt in predicted.items():
+            err = 100.0 * np.sqrt(((nxt[:, cols] - after[seen][:, cols]) ** 2).mean(axis=1))
+            entry[effects] = {"median_cm": round(float(np.median(err)), 2), "p90_cm": round(float(np.percentile(err, 90)), 2)}
+        out[channel] = entry
+    return out
 
 
 def _open_set(model, name: str, data, rows: np.ndarray, X: np.ndarray, y: np.ndarray, predictor) -> dict:

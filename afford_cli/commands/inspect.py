@@ -139,6 +139,14 @@ def render(console, info: dict) -> None:
                 cv = report["cv"]
                 extra.append(f"cross-validated accuracy {100 * cv['cv_accuracy']:.1f}% "
                              f"(C={cv['best_params'].get('C')}, gamma={cv['best_params'].get('gamma', '-')})")
+            if report.get("member_effects"):
+                me = report["member_effects"]
+                loo = me.get("loo_error", {})
+                k = me.get("k")
+                extra.append("effect within a category: " + (
+                    "the prototype (every member)" if k == 0 else f"the mean of the {k} most similar members") + (
+                    f"; leave-one-out error {loo.get(str(k))} against the prototype's {loo.get('0')} (goal tolerances)"
+                    if str(k) in loo and "0" in loo else ""))
             for line in extra:
                 console.print(f"  {line}")
 
@@ -164,6 +172,9 @@ def _behaviour_reports(m: dict) -> dict:
                 report["relevance"] = rel["scores"]
         if name in m.get("cv", {}):
             report["cv"] = m["cv"][name]
+        members = m.get("member_effects", {}).get(name) if isinstance(m.get("member_effects"), dict) else None
+        if isinstance(members, dict):
+            report["member_effects"] = {"k": members.get("k"), "loo_error": members.get("loo_error", {})}
         reports[name] = report
     return reports
 

@@ -12,7 +12,7 @@ from afford.artifacts import write_artifact
 from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
-from afford.options import Json, Layout, MaxDepth, Objects, SceneName, SceneSeed, check_scene_source
+from afford.options import EffectModel, Effects, Json, Layout, MaxDepth, Objects, SceneName, SceneSeed, check_scene_source
 from afford.output import Output
 from afford.scenes_io import open_world, scene_layout
 
@@ -41,6 +41,7 @@ def pddl(
     max_depth: MaxDepth = 5,
     solve: Annotated[bool, typer.Option("--solve", help="Also solve the deterministic PDDL with Fast Downward (the optional pddl extra).")] = False,
     execute: Annotated[bool, typer.Option("--execute", help="Run Fast Downward's plan in the simulator, blind, and say whether the goal held (implies --solve).")] = False,
+    effects: Effects = EffectModel.members,
     json: Json = False,
 ) -> None:
     """Write the model and the perceived scene as PDDL (determinised) and PPDDL (calibrated probabilities)."""
@@ -53,6 +54,7 @@ def pddl(
 
         check_solver()
     loaded = load_model(model)
+    loaded.effect_model = effects.value
     loaded.check_effects("PDDL")
     g = parse_goal(goal, loaded.schema)
     sc, specs = scene_layout(scene, seed, layout, objects=objects)

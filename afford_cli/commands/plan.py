@@ -13,6 +13,7 @@ from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
 from afford.options import (
+    EffectModel, Effects,
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
 )
 from afford.output import Output
@@ -89,6 +90,7 @@ def plan(
     button: Annotated[bool, typer.Option("--button", help="Add the fixed flat button of thesis 7.6.5 to a drawn scene (crane-lift).")] = False,
     alternatives: Alternatives = 3,
     plot: PlotFile = None,
+    effects: Effects = EffectModel.members,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
@@ -98,6 +100,7 @@ def plan(
         raise typer.BadParameter("--plot draws one scene; it does not go with --episodes")
     check_plot_file(plot)
     loaded = load_model(model)
+    loaded.effect_model = effects.value
     loaded.check_effects("planning")
     g = parse_goal(goal, loaded.schema)
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}

@@ -16,10 +16,19 @@ from rich import box
 from rich.table import Table
 
 from afford.learning import load_model
-from afford.options import Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
+from afford.options import EffectModel, Effects, Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
 from afford.scenes_io import open_world, scene_layout
+
+def _change(now: dict, nxt: dict, shown: int = 2) -> str:
+    """The features the step is expected to change most, with the spread: ``y_min -0.142±0.011``."""
+    if not nxt["visible"]:
+        return "gone from view"
+    moves = sorted(((abs(v - now[n]), n, v - now[n]) for n, v in nxt["features"].items() if n in now), reverse=True)
+    parts = [f"{n} {d:+.3f}±{nxt.get('spread', {}).get(n, 0.0):.3f}" for size, n, d in moves[:shown] if size >= 0.005]
+    return ", ".join(parts) or "none"
+
 
 def check(model, scene, layout, seed: int, preds: list[dict]) -> dict:
     """Run each behaviour from the same start in the simulator; did the prediction hold?
@@ -94,12 +103,14 @@ def predict(
     run_check: Annotated[bool, typer.Option("--check", help="Also run each behaviour in the simulator, every one from the same start, and report whether the prediction held.")] = False,
     want: Annotated[Optional[list[str]], typer.Option("--want", help="Inverse query: rank (object, behaviour, alpha) by the probability that one step makes OBJ:FEATURE=VALUE~RANGE hold.")] = None,
     plot: PlotFile = None,
+    effects: Effects = EffectModel.members,
     json: Json = False,
 ) -> None:
     """Predict, for every entity the robot sees, what each behaviour would do."""
     check_scene_source(layout, seed, objects=objects)
     check_plot_file(plot)
     loaded = load_model(model)
+    loaded.effect_model = effects.value
     if want:
         loaded.check_effects("an inverse query (--want)")
     sc, specs = scene_layout(scene, seed, layout, objects=objects)
@@ -131,7 +142,7 @@ def predict(
                       box=box.SIMPLE_HEAD)
             cols = ["behaviour", "result" if given else "category", "p"]
             if not given:
-                cols += ["members were mostly", "seen after"]
+                cols += ["members were mostly", "seen after", "expected change"]
             for col in cols:
                 t.add_column(col, no_wrap=True)
             if run_check:
@@ -140,7 +151,8 @@ def predict(
                 row = [name, p["result"] if given else str(p["category"]), f"{p['probability']:.2f}"]
                 if not given:
                     outcomes = cats[name][p["category"]].get("outcomes", {})
-                    row += [max(outcomes, key=outcomes.get) if outcomes else "?", "yes" if p["next"]["visible"] else "no"]
+                    row += [max(outcomes, key=outcomes.get) if outcomes else "?", "yes" if p["next"]["visible"] else "no",
+                            _change(e["features"], p["next"])]
                 if run_check:
                     seen = p.get("observed_result", p["observed_category"])
                     row.append(("[green]held" if p["held"] else f"[red]was {seen}") + "[/]"

@@ -1,0 +1,116 @@
+"""Member effects: each object's own effect within its category (issue 17's forward model)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from afford.features import FeatureSchema
+from afford.learn.members import MemberEffects
+from afford.plan.forward import BehaviorModel, ForwardModel
+from afford.plan.goals import parse_goal
+from afford.plan.monitor import reach_probability
+from afford.plan.search import best_first
+
+
+def _planted(n: int, rng, noise: float = 0.005):
+    """Two features (width, colour) and one category whose push moves x by half the width
+    (as a palm pushed to the centre does), a second category that never moves."""
+    width = rng.uniform(0.08, 0.40, n)
+    colour = rng.uniform(0, 1, n)  # irrelevant
+    X = np.column_stack([width, colour])
+    labels = (rng.random(n) < 0.5).astype(int)
+    E = np.zeros((n, 2))
+    E[labels == 0, 0] = width[labels == 0] / 2 + rng.normal(0, noise, (labels == 0).sum())
+    return X, E, labels
+
+
+def _members(X, E, labels, **kw):
+    return MemberEffects(["position", "colour"], ["position", "colour"], [0.05, 0.1], **kw).fit(X, E, labels)
+
+
+def test_member_effects_recover_a_planted_dependence_the_prototype_cannot():
+    rng = np.random.default_rng(0)
+    X, E, labels = _planted(600, rng)
+    m = _members(X, E, labels)
+    assert m.k_ != 0  # the prototype (every member) lost the leave-one-out choice
+    assert m.loo_error_[m.k_] < 0.5 * m.loo_error_[0]
+    Xt, Et, lt = _planted(200, np.random.default_rng(1))
+    moved = lt == 0
+    pred = np.array([m.predict(x, 0)[0][0] for x in Xt[moved]])
+    prototype = E[labels == 0, 0].mean()
+    member_err = np.abs(pred - Et[moved, 0])
+    prototype_err = np.abs(prototype - Et[moved, 0])
+    assert np.median(member_err) < 0.01 < np.median(prototype_err)
+    # the spread is the few members' own scatter, far below the category's
+    assert m.predict(Xt[moved][0], 0)[1][0] < 0.3 * E[labels == 0, 0].std()
+
+
+def test_member_effects_fall_back_on_the_prototype_when_features_tell_nothing():
+    rng = np.random.default_rng(2)
+    X = rng.uniform(0, 1, (500, 2))
+    labels = np.zeros(500, dtype=int)
+    E = np.column_stack([rng.normal(0.1, 0.03, 500), np.zeros(500)])  # pure noise around one mean
+    m = _members(X, E, labels)
+    # averaging more members only helps: the largest counts win
+    assert m.k_ in (0, 20)
+    assert m.loo_error_[m.k_] <= min(m.loo_error_[3], m.loo_error_[5])
+
+
+def test_member_effects_round_trip_through_plain_arrays_and_refuse_parts_that_do_not_fit():
+    rng = np.random.default_rng(3)
+    X, E, labels = _planted(300, rng)
+    m = _members(X, E, labels)
+    arrays, meta = m.to_arrays()
+    assert all(isinstance(a, np.ndarray) and a.dtype != object for a in arrays.values())
+    back = MemberEffects.from_arrays(arrays, meta)
+    x = np.array([0.3, 0.5])
+    assert np.array_equal(back.predict(x, 0)[0], m.predict(x, 0)[0]) and back.k_ == m.k_
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays({**arrays, "E": arrays["E"][:5]}, meta)
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays({**arrays, "weight": arrays["weight"][:1]}, meta)
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays(arrays, {**meta, "k": "many"})
+
+
+class _Const:
+    """A predictor that is sure of category 0 for every object."""
+
+    classes_ = np.array([0, 1])
+
+    def predict_proba(self, X):
+        return np.tile([0.9, 0.1], (len(X), 1))
+
+
+def _forward(effects: str, members: MemberEffects) -> tuple[ForwardModel, FeatureSchema]:
+    schema = FeatureSchema(("x", "colour"), ("position", "colour"))
+    prototypes = np.array([[members.E_[members.labels_ == 0, 0].mean(), 0.0], [0.0, 0.0]])
+    b = BehaviorModel("push", _Const(), np.array([0, 1]), prototypes, members=members)
+    return ForwardModel([b], schema, effects=effects), schema
+
+
+def test_the_planner_moves_each_object_by_its_own_effect_and_rollouts_draw_from_its_members():
+    rng = np.random.default_rng(4)
+    X, E, labels = _planted(600, rng, noise=0.02)
+    m = _members(X, E, labels)
+    fm, schema = _forward("members", m)
+    proto, _ = _forward("prototype", m)
+    narrow, wide = np.array([[0.10, 0.5]]), np.array([[0.38, 0.5]])
+    # the member model tells a narrow object's push from a wide one's; the prototype does not
+    assert fm.apply(narrow, 0, 0, 0)[0, 0] == pytest.approx(0.10 + 0.05, abs=0.02)
+    assert fm.apply(wide, 0, 0, 0)[0, 0] == pytest.approx(0.38 + 0.19, abs=0.02)
+    assert proto.apply(narrow, 0, 0, 0)[0, 0] - 0.10 == pytest.approx(proto.apply(wide, 0, 0, 0)[0, 0] - 0.38)
+    # a goal tighter than the category's spread: x = 0.57 +- 0.03 for the wide object
+    goal = parse_goal(["0:x=0.57~0.03"], schema)
+    assert best_first(fm, wide, goal, max_depth=2).found
+    plan = best_first(proto, wide, goal, max_depth=2)
+    assert not plan.found or abs(proto.apply(wide, 0, 0, 0)[0, 0] - 0.57) <= 0.03
+    # imagined worlds draw each push from the nearest members' own effects: a spread of ends,
+    # so the chance of landing within 1 cm of the mean is below the category's 0.9, and above nothing
+    aim = fm.apply(wide, 0, 0, 0)[0, 0]
+    tight = parse_goal([f"0:x={aim:.4f}~0.01"], schema)
+    tight_plan = best_first(fm, wide, tight, max_depth=1)
+    assert tight_plan.found
+    p = reach_probability(fm, wide, tight, tight_plan, max_replans=0, rollouts=200, seed=0)
+    assert 0.05 < p < 0.85
