@@ -8,9 +8,9 @@ to the object's centre, so a wide box travels further than a narrow one; a ball 
 
 :class:`MemberEffects` predicts, within a category, the mean effect of the ``k`` category
 members whose entity (and parameters) looked most like the one at hand, and keeps those
-``k`` effects as the distribution a rollout draws from. ``k`` is chosen per behaviour by
-leave-one-out error among a few values, one of which is "every member": the thesis's
-prototype, so the choice can always fall back on it. Similarity is Euclidean in a space
+``k`` effects as the distribution a rollout draws from. ``k`` is chosen per behaviour and
+effect channel by leave-one-out error among a few values, one of which is "every member":
+the thesis's prototype, so the choice can always fall back on it. Similarity is Euclidean in a space
 where each feature is standardised and each channel (position, shape, ...) weighs the same
 in all, however many features it has: otherwise the 36 shape bins of the table would drown
 its six position features. Measured on 5000 table interactions (held out: 1000 of another
@@ -53,10 +53,12 @@ class MemberEffects:
 
     Attributes (after :meth:`fit`)
     ------------------------------
-    k_ : int
-        The chosen neighbour count (0: every member, the prototype).
-    loo_error_ : dict of int to float
-        Mean leave-one-out error per k tried (tolerance units, summed over channels).
+    k_ : dict of str to int
+        Per effect channel, the chosen neighbour count (0: every member, the prototype):
+        how far a push moves an object may depend on its width while how its shape bins
+        jitter does not, so each channel takes the count that predicts it best.
+    loo_error_ : dict of str to dict of int to float
+        Per channel, the mean leave-one-out error of each k tried (tolerance units).
     """
 
     def __init__(self, groups, effect_groups, tolerances, k_grid: tuple[int, ...] = K_GRID, random_state: int = 0):
@@ -87,19 +89,25 @@ class MemberEffects:
         self.E_ = E.astype(np.float32)
         self.labels_ = labels.astype(np.int16)
         self.loo_error_ = self._leave_one_out()
-        self.k_ = min(self.loo_error_, key=lambda k: (self.loo_error_[k], k == 0, k)) if self.loo_error_ else 0
+        self.k_ = {ch: (min(errors, key=lambda k: (errors[k], k != 0, k)) if errors else 0)
+                   for ch, errors in self.loo_error_.items()}
         self._index()
         return self
 
-    def _error(self, pred: np.ndarray, E: np.ndarray) -> np.ndarray:
-        """Per row: the error in tolerance units, the root mean square of each channel, summed over channels."""
+    @property
+    def channels(self) -> list[str]:
+        return list(dict.fromkeys(self.effect_groups))
+
+    def _errors(self, pred: np.ndarray, E: np.ndarray) -> dict[str, np.ndarray]:
+        """Per channel and row: the root mean square error over the channel's columns, in tolerance units."""
         r = (pred - E) / np.where(self.tolerances > 0, self.tolerances, 1.0)
         ch = np.asarray(self.effect_groups)
-        return sum(np.sqrt((r[:, ch == name] ** 2).mean(axis=1)) for name in dict.fromkeys(self.effect_groups))
+        return {name: np.sqrt((r[:, ch == name] ** 2).mean(axis=1)) for name in self.channels}
 
-    def _leave_one_out(self) -> dict[int, float]:
+    def _leave_one_out(self) -> dict[str, dict[int, float]]:
+        """Per channel, the mean leave-one-out error of each k (tolerance units)."""
         rng = np.random.default_rng(self.random_state)
-        total = {k: 0.0 for k in self.k_grid}
+        total = {ch: {k: 0.0 for k in self.k_grid} for ch in self.channels}
         n = 0
         for c in np.unique(self.labels_):
             rows = np.flatnonzero(self.labels_ == c)
@@ -116,95 +124,119 @@ class MemberEffects:
             everyone = (Ec.sum(axis=0)[None, :] - Et) / (rows.size - 1)  # every other member: the prototype
             for k in self.k_grid:
                 pred = everyone if k == 0 or k > kmax else csum[:, k - 1] / k
-                total[k] += float(self._error(pred, Et).sum())
+                for ch, err in self._errors(pred, Et).items():
+                    total[ch][k] += float(err.sum())
             n += test.size
-        return {k: v / n for k, v in total.items()} if n else {}
+        return {ch: {k: v / n for k, v in errors.items()} for ch, errors in total.items()} if n else \
+            {ch: {} for ch in self.channels}
 
     def _index(self) -> None:
         self._rows = {int(c): np.flatnonzero(self.labels_ == c) for c in np.unique(self.labels_)}
-        self._Z = self.Z_.astype(float)
+        # members sorted by category (rows in order within each): one block per category
+        perm = np.argsort(self.labels_, kind="stable")
+        self._perm = perm
+        self._lab = self.labels_[perm].astype(np.int64)
+        self._Z = np.ascontiguousarray(self.Z_[perm], dtype=float)
+        self._ZT = np.ascontiguousarray(self._Z.T)
         self._sq = (self._Z * self._Z).sum(1)
         self._E = self.E_.astype(float)
+        self._Es = self._E[perm]
         n_cat = int(self.labels_.max()) + 1 if self.labels_.size else 0
         counts = np.bincount(self.labels_.astype(int), minlength=n_cat)
         self._known = counts > 0
-        # the members of every category as one padded table (row -1: no member), so that one
-        # partition finds every category's nearest at once
-        width = int(counts.max()) if n_cat else 0
-        self._table = np.full((n_cat, width), -1, dtype=np.int64)
-        for c, rows in self._rows.items():
-            self._table[c, : rows.size] = rows
+        self._start = np.concatenate([[0], np.cumsum(counts)])[:-1]
         self._all_means = np.zeros((n_cat, self._E.shape[1]))
         for c, rows in self._rows.items():
             self._all_means[c] = self._E[rows].mean(axis=0)
+        # per distinct k: which of the grouped positions are each category's k nearest (its
+        # block's first k), and the effect columns of the channels that use that k
+        ch = np.asarray(self.effect_groups)
+        self._by_k = []
+        for k in sorted(set(self.k_.values())):
+            cols = np.flatnonzero(np.isin(ch, [c for c, kc in self.k_.items() if kc == k]))
+            if k == 0:
+                self._by_k.append((0, cols, None, None, None, None))
+                continue
+            taken = np.minimum(counts, k)
+            cats = np.flatnonzero(taken > 0)
+            pick = np.concatenate([self._start[c] + np.arange(taken[c]) for c in cats]) if cats.size \
+                else np.zeros(0, dtype=np.int64)
+            segments = np.concatenate([[0], np.cumsum(taken[cats])])[:-1]
+            self._by_k.append((k, cols, cats, pick, segments, taken[cats].astype(float)))
 
     # -- predicting ------------------------------------------------------------------------
-    def _distances(self, x: np.ndarray) -> np.ndarray:
-        """Squared distance (up to a constant) from input ``x`` (or each row of a 2-D ``x``) to every member."""
+    def _grouped(self, x: np.ndarray) -> np.ndarray:
+        """Positions (in category order) of every member: category by category, each block
+        nearest to input ``x`` first (ties: the lower row). A 2-D ``x``: one row per query."""
         z = (np.asarray(x, dtype=float) - self.shift_) * self.weight_
-        return self._sq - 2.0 * (z @ self._Z.T)
-
-    def _nearest(self, d: np.ndarray, table: np.ndarray) -> np.ndarray:
-        """Per row of ``table`` (member rows, -1 padding), its ``k_`` members nearest by ``d``
-        (one row of distances, or one per query: then the result has a leading query axis),
-        nearest first (ties: the lower row), padding last."""
-        dist = np.where(table >= 0, d[..., np.maximum(table, 0)], np.inf)
-        k = min(self.k_, table.shape[1])
-        part = np.argpartition(dist, k - 1, axis=-1)[..., :k] if k < table.shape[1] else np.argsort(dist, axis=-1)
-        cand = np.take_along_axis(np.broadcast_to(table, dist.shape), part, axis=-1)
-        cd = np.take_along_axis(dist, part, axis=-1)
-        # sorted by (distance, row): exact and stable, so ties never depend on the batch
-        order = np.lexsort((cand, cd), axis=-1)
-        return np.take_along_axis(cand, order, axis=-1)
+        d = self._sq - 2.0 * (z @ self._ZT)
+        order = np.argsort(d, axis=-1, kind="stable")
+        within = np.argsort(self._lab[order], axis=-1, kind="stable")  # category blocks, nearest first
+        return np.take_along_axis(order, within, axis=-1)
 
     def has(self, category: int) -> bool:
         return int(category) in self._rows
 
-    def neighbours(self, x: np.ndarray, category: int) -> np.ndarray:
-        """Rows (into ``E_``) of the members of ``category`` nearest to input ``x``, nearest first
-        (``k_`` of them; every member for ``k_`` 0 or a category that small)."""
+    def neighbours(self, x: np.ndarray, category: int, channel: str) -> np.ndarray:
+        """Rows (into ``E_``) of the members of ``category`` nearest to input ``x``, nearest first:
+        as many as ``channel`` uses (every member for k 0 or a category that small)."""
         rows = self._rows.get(int(category))
         if rows is None:
             raise KeyError(f"no members of category {category}")
-        if self.k_ == 0 or self.k_ >= rows.size:
+        k = self.k_[channel]
+        if k == 0 or k >= rows.size:
             return rows
-        return self._nearest(self._distances(x), rows[None, :])[0]
+        start = int(self._start[int(category)])
+        return self._perm[self._grouped(x)[start: start + k]]
 
     def means(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(mean effect per category id, shape (n_categories, n_features); which ids have
-        members): every category's prediction for input ``x`` at once, one distance pass.
-        A 2-D ``x`` gives one such table per row (leading axis), in one pass for all."""
+        members): every category's prediction for input ``x`` at once, one distance pass, each
+        channel the mean of its own number of nearest members. A 2-D ``x`` gives one such
+        table per row (leading axis), in one pass for all."""
         x = np.asarray(x, dtype=float)
-        if self.k_ == 0 or self.k_ >= self._table.shape[1]:
-            return (self._all_means if x.ndim == 1 else np.broadcast_to(self._all_means, (len(x),) + self._all_means.shape)), self._known
-        near = self._nearest(self._distances(x), self._table)
-        valid = near >= 0
-        sums = (self._E[np.maximum(near, 0)] * valid[..., None]).sum(axis=-2)
-        n = valid.sum(axis=-1)
-        out = np.where((n > 0)[..., None], sums / np.maximum(n, 1)[..., None], self._all_means)
+        out = np.array(np.broadcast_to(self._all_means, x.shape[:-1] + self._all_means.shape))
+        grouped = None
+        for k, cols, cats, pick, segments, taken in self._by_k:
+            if k == 0:
+                continue  # every member: the category's mean already
+            if grouped is None:
+                grouped = self._grouped(x)
+            picked = self._Es[grouped[..., pick]][..., cols]  # (..., picked members, columns)
+            sums = np.add.reduceat(picked, segments, axis=-2)
+            out[..., cats[:, None], cols[None, :]] = sums / taken[:, None]
         return out, self._known
 
     def category_spread(self, category: int) -> np.ndarray:
         """The standard deviation of the effects of every member of ``category``."""
         return self._E[self._rows[int(category)]].std(axis=0)
 
-    def effects(self, x: np.ndarray, category: int) -> np.ndarray:
-        """The effects the nearest members of ``category`` had: the distribution a rollout draws from."""
-        return self._E[self.neighbours(x, category)]
+    def effects(self, x: np.ndarray, category: int, channel: str) -> np.ndarray:
+        """The effects the members of ``category`` nearest to ``x`` had, as many as ``channel``
+        uses: the distribution a rollout draws that channel from."""
+        return self._E[self.neighbours(x, category, channel)]
 
     def predict(self, x: np.ndarray, category: int) -> tuple[np.ndarray, np.ndarray]:
-        """(mean effect, its spread: the standard deviation of the members' effects)."""
-        e = self.effects(x, category)
-        return e.mean(axis=0), e.std(axis=0)
+        """(mean effect, its spread: per channel the standard deviation of the effects of the
+        members that channel's mean rests on)."""
+        mean = np.zeros(len(self.effect_groups))
+        spread = np.zeros(len(self.effect_groups))
+        ch = np.asarray(self.effect_groups)
+        for channel in self.channels:
+            cols = ch == channel
+            e = self.effects(x, category, channel)[:, cols]
+            mean[cols], spread[cols] = e.mean(axis=0), e.std(axis=0)
+        return mean, spread
 
     # -- storing ---------------------------------------------------------------------------
     def to_arrays(self) -> tuple[dict[str, np.ndarray], dict]:
         """Plain arrays and a JSON-able description, all a model file needs to hold."""
         arrays = {"Z": self.Z_, "E": self.E_, "labels": self.labels_,
                   "shift": self.shift_.astype(np.float64), "weight": self.weight_.astype(np.float64)}
-        meta = {"k": int(self.k_), "groups": list(self.groups), "effect_groups": list(self.effect_groups),
-                "tolerances": [float(t) for t in self.tolerances],
-                "loo_error": {str(k): round(float(v), 5) for k, v in self.loo_error_.items()}}
+        meta = {"k": {ch: int(k) for ch, k in self.k_.items()}, "groups": list(self.groups),
+                "effect_groups": list(self.effect_groups), "tolerances": [float(t) for t in self.tolerances],
+                "loo_error": {ch: {str(k): round(float(v), 5) for k, v in errors.items()}
+                              for ch, errors in self.loo_error_.items()}}
         return arrays, meta
 
     @classmethod
@@ -212,8 +244,9 @@ class MemberEffects:
         """The fitted model back from :meth:`to_arrays`; ``ValueError`` when the parts do not fit together."""
         try:
             self = cls(meta["groups"], meta["effect_groups"], meta["tolerances"])
-            self.k_ = int(meta["k"])
-            self.loo_error_ = {int(k): float(v) for k, v in dict(meta.get("loo_error", {})).items()}
+            self.k_ = {str(ch): int(k) for ch, k in dict(meta["k"]).items()}
+            self.loo_error_ = {str(ch): {int(k): float(v) for k, v in dict(errors).items()}
+                               for ch, errors in dict(meta.get("loo_error", {})).items()}
             Z, E, labels = arrays["Z"], arrays["E"], arrays["labels"]
             shift, weight = arrays["shift"], arrays["weight"]
         except (KeyError, TypeError, ValueError) as exc:
@@ -221,7 +254,7 @@ class MemberEffects:
         n, d = Z.shape if Z.ndim == 2 else (-1, -1)
         if (Z.ndim != 2 or E.ndim != 2 or labels.shape != (n,) or E.shape[0] != n or d != len(self.groups)
                 or shift.shape != (d,) or weight.shape != (d,) or E.shape[1] != len(self.effect_groups)
-                or self.k_ < 0 or labels.dtype.kind not in "iu" or (labels.size and labels.min() < 0) or Z.dtype.kind != "f" or E.dtype.kind != "f"
+                or set(self.k_) != set(self.channels) or min(self.k_.values(), default=0) < 0 or labels.dtype.kind not in "iu" or (labels.size and labels.min() < 0) or Z.dtype.kind != "f" or E.dtype.kind != "f"
                 or not (np.all(np.isfinite(Z)) and np.all(np.isfinite(E)))):
             raise ValueError("the member effects' arrays do not fit together")
         self.Z_, self.E_, self.labels_ = Z.astype(np.float32), E.astype(np.float32), labels.astype(np.int16)

@@ -361,13 +361,30 @@ class _Margins(ClassifierMixin, BaseEstimator):
         self.parts_ = [(e.support_vectors_, (e.support_vectors_ ** 2).sum(1), e.dual_coef_[0], e.intercept_[0], float(e.gamma))  # the grid passes gamma as a number
                        for e in ovr.estimators_]
         self.classes_ = ovr.classes_
+        # The one-vs-rest machines share most of their support vectors (they are all rows of
+        # one training set): with one gamma, the kernel is computed once on their union and
+        # each machine reads its own columns of it.
+        gammas = {g for *_, g in self.parts_}
+        if len(gammas) == 1 and self.parts_:
+            union, inverse = np.unique(np.vstack([sv for sv, *_ in self.parts_]), axis=0, return_inverse=True)
+            inverse = inverse.reshape(-1)
+            bounds = np.cumsum([0] + [sv.shape[0] for sv, *_ in self.parts_])
+            self.union_ = (union, (union ** 2).sum(1), gammas.pop())
+            self.columns_ = [inverse[bounds[i]:bounds[i + 1]] for i in range(len(self.parts_))]
+        else:
+            self.union_ = None
         return self
 
     def decision_function(self, X):
         Z = (np.asarray(X, dtype=np.float64) - self.mean_) / self.std_
         zz = (Z * Z).sum(1)[:, None]
-        cols = [np.exp(-g * np.maximum(zz - 2.0 * Z @ sv.T + sq[None, :], 0.0)) @ coef + b
-                for sv, sq, coef, b, g in self.parts_]
+        if getattr(self, "union_", None) is not None:
+            sv, sq, g = self.union_
+            K = np.exp(-g * np.maximum(zz - 2.0 * Z @ sv.T + sq[None, :], 0.0))
+            cols = [K[:, idx] @ coef + b for idx, (_, _, coef, b, _) in zip(self.columns_, self.parts_)]
+        else:
+            cols = [np.exp(-g * np.maximum(zz - 2.0 * Z @ sv.T + sq[None, :], 0.0)) @ coef + b
+                    for sv, sq, coef, b, g in self.parts_]
         D = np.column_stack(cols)
         return D[:, 0] if D.shape[1] == 1 else D
 

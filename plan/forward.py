@@ -250,13 +250,33 @@ class ForwardModel:
         return members.category_spread(category)
 
     def draw_effect(self, f: np.ndarray, b: int, category: int, alpha: tuple, rng: np.random.Generator) -> np.ndarray:
-        """One effect of category ``category`` on ``f`` as a world might give it: one of the
-        nearest members' own effects (the prototype, without member effects)."""
+        """One effect of category ``category`` on ``f`` as a world might give it: the
+        predicted (mean) effect, with its geometry (where the object goes, what goals are
+        mostly about) taken from one of the nearest members' own effects (channels whose
+        best count was every member keep the mean: the members say nothing of this object
+        there), snapped so that
+        the object lands on a lattice of a quarter of each feature's goal tolerance (1.25 cm
+        at the table). Imagined worlds then share states, and their replans, where the
+        members' effects lie within that lattice; the drawn spread stays. Without member
+        effects: the prototype."""
+        mean = self.effect(f, b, category, alpha)
         members = self._members(b, category)
         if members is None:
-            return self.effect(f, b, category, alpha)
-        effects = members.effects(self._member_input(self.behaviors[b], f, alpha), category)
-        return effects[int(rng.integers(len(effects)))]
+            return mean
+        x = self._member_input(self.behaviors[b], f, alpha)
+        out = mean.copy()
+        cols = self.schema.geometry
+        channels = np.asarray(self.schema.channels)
+        r = int(rng.integers(1 << 30))  # one draw: the same neighbour rank for every channel
+        for channel in dict.fromkeys(channels[cols]):
+            if members.k_.get(channel, 0) == 0:
+                continue  # the prototype predicted this channel best: its members say nothing of this object
+            effects = members.effects(x, category, channel)
+            mine = cols[channels[cols] == channel]
+            out[mine] = effects[r % len(effects)][mine]
+        step = self.schema.tolerances[cols] / 4.0
+        out[cols] = np.round((f[cols] + out[cols]) / step) * step - f[cols]
+        return out
 
     def _moved(self, before: np.ndarray, b: int, category: int, alpha: tuple = (),
                effect: np.ndarray | None = None) -> np.ndarray:

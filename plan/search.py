@@ -155,10 +155,22 @@ NO_OP = 0.1
 
 def _no_op(model: ForwardModel, before: np.ndarray, after: np.ndarray, obj: int) -> bool:
     """Neither visibility nor geometry moved (histograms jitter with the view)."""
-    schema = model.schema
-    cols = schema.geometry if schema.visibility_index is None else np.append(schema.geometry, schema.visibility_index)
+    cols, limit = _no_op_columns(model.schema)
     rows = slice(None) if obj == SCENE else obj
-    return bool((np.abs(after[rows][..., cols] - before[rows][..., cols]) < NO_OP * schema.tolerances[cols]).all())
+    return bool((np.abs(after[rows][..., cols] - before[rows][..., cols]) < limit).all())
+
+
+_NO_OP_COLUMNS: dict = {}
+
+
+def _no_op_columns(schema) -> tuple[np.ndarray, np.ndarray]:
+    """The columns :func:`_no_op` compares (geometry and visibility) and their limits, once per schema."""
+    key = id(schema)
+    hit = _NO_OP_COLUMNS.get(key)
+    if hit is None or hit[0] is not schema:
+        cols = schema.geometry if schema.visibility_index is None else np.append(schema.geometry, schema.visibility_index)
+        hit = _NO_OP_COLUMNS[key] = (schema, cols, NO_OP * schema.tolerances[cols])
+    return hit[1], hit[2]
 
 
 def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None, held: int = -1):

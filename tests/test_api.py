@@ -97,9 +97,14 @@ def test_predict_effects_option_chooses_the_members_or_the_prototype(pipeline):
                 if effects == "prototype":
                     effect = model.prototypes[name][c]
                 else:
-                    effect = members.E_[members.neighbours(state[i], c)].astype(float).mean(axis=0)
-                    spread = members.E_[members.neighbours(state[i], c)].astype(float).std(axis=0)
-                    assert p["next"]["spread"] == {model.schema.names[j]: round(float(spread[j]), 4) for j in geometry}
+                    effect = np.zeros(len(model.schema))
+                    spread = np.zeros(len(model.schema))
+                    for channel in model.schema.channel_names:
+                        cols = model.schema.channel_indices(channel)
+                        near = members.E_[members.neighbours(state[i], c, channel)][:, cols].astype(float)
+                        effect[cols], spread[cols] = near.mean(axis=0), near.std(axis=0)
+                    assert p["next"]["spread"] == pytest.approx(
+                        {model.schema.names[j]: round(float(spread[j]), 4) for j in geometry}, abs=2e-4)
                 want = state[i] + effect
                 for j in geometry:
                     assert p["next"]["features"][model.schema.names[j]] == pytest.approx(want[j], abs=2e-4)

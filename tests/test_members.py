@@ -33,8 +33,9 @@ def test_member_effects_recover_a_planted_dependence_the_prototype_cannot():
     rng = np.random.default_rng(0)
     X, E, labels = _planted(600, rng)
     m = _members(X, E, labels)
-    assert m.k_ != 0  # the prototype (every member) lost the leave-one-out choice
-    assert m.loo_error_[m.k_] < 0.5 * m.loo_error_[0]
+    k = m.k_["position"]
+    assert k != 0  # the prototype (every member) lost the leave-one-out choice
+    assert m.loo_error_["position"][k] < 0.5 * m.loo_error_["position"][0]
     Xt, Et, lt = _planted(200, np.random.default_rng(1))
     moved = lt == 0
     pred = np.array([m.predict(x, 0)[0][0] for x in Xt[moved]])
@@ -52,9 +53,10 @@ def test_member_effects_fall_back_on_the_prototype_when_features_tell_nothing():
     labels = np.zeros(500, dtype=int)
     E = np.column_stack([rng.normal(0.1, 0.03, 500), np.zeros(500)])  # pure noise around one mean
     m = _members(X, E, labels)
-    # averaging more members only helps: the largest counts win
-    assert m.k_ in (0, 20)
-    assert m.loo_error_[m.k_] <= min(m.loo_error_[3], m.loo_error_[5])
+    # averaging more members only helps: every member (the prototype) or the largest count wins
+    k, errors = m.k_["position"], m.loo_error_["position"]
+    assert k in (0, 20)
+    assert errors[k] <= min(errors[3], errors[5])
 
 
 def test_member_effects_round_trip_through_plain_arrays_and_refuse_parts_that_do_not_fit():
@@ -66,12 +68,15 @@ def test_member_effects_round_trip_through_plain_arrays_and_refuse_parts_that_do
     back = MemberEffects.from_arrays(arrays, meta)
     x = np.array([0.3, 0.5])
     assert np.array_equal(back.predict(x, 0)[0], m.predict(x, 0)[0]) and back.k_ == m.k_
+    assert np.allclose(back.means(x)[0][0], m.predict(x, 0)[0])
     with pytest.raises(ValueError):
         MemberEffects.from_arrays({**arrays, "E": arrays["E"][:5]}, meta)
     with pytest.raises(ValueError):
         MemberEffects.from_arrays({**arrays, "weight": arrays["weight"][:1]}, meta)
     with pytest.raises(ValueError):
         MemberEffects.from_arrays(arrays, {**meta, "k": "many"})
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays(arrays, {**meta, "k": {"position": 5}})  # a channel without its count
 
 
 class _Const:
@@ -96,6 +101,7 @@ def test_the_planner_moves_each_object_by_its_own_effect_and_rollouts_draw_from_
     m = _members(X, E, labels)
     fm, schema = _forward("members", m)
     proto, _ = _forward("prototype", m)
+    assert m.k_["position"] != 0
     narrow, wide = np.array([[0.10, 0.5]]), np.array([[0.38, 0.5]])
     # the member model tells a narrow object's push from a wide one's; the prototype does not
     assert fm.apply(narrow, 0, 0, 0)[0, 0] == pytest.approx(0.10 + 0.05, abs=0.02)

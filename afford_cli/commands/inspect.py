@@ -141,12 +141,17 @@ def render(console, info: dict) -> None:
                              f"(C={cv['best_params'].get('C')}, gamma={cv['best_params'].get('gamma', '-')})")
             if report.get("member_effects"):
                 me = report["member_effects"]
-                loo = me.get("loo_error", {})
-                k = me.get("k")
-                extra.append("effect within a category: " + (
-                    "the prototype (every member)" if k == 0 else f"the mean of the {k} most similar members") + (
-                    f"; leave-one-out error {loo.get(str(k))} against the prototype's {loo.get('0')} (goal tolerances)"
-                    if str(k) in loo and "0" in loo else ""))
+                k = me.get("k") if isinstance(me.get("k"), dict) else {}
+                loo = me.get("loo_error", {}) if isinstance(me.get("loo_error"), dict) else {}
+                parts = []
+                for ch, kc in k.items():
+                    errors = loo.get(ch, {}) if isinstance(loo.get(ch), dict) else {}
+                    said = "the prototype" if kc == 0 else f"the {kc} most similar members"
+                    if str(kc) in errors and "0" in errors and kc != 0:
+                        said += f" (leave-one-out error {errors[str(kc)]:.3f} against the prototype's {errors['0']:.3f})"
+                    parts.append(f"{ch}: {said}")
+                if parts:
+                    extra.append("effect within a category, per channel: " + "; ".join(parts))
             for line in extra:
                 console.print(f"  {line}")
 
