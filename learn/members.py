@@ -177,9 +177,10 @@ class MemberEffects:
     def has(self, category: int) -> bool:
         return int(category) in self._rows
 
-    def neighbours(self, x: np.ndarray, category: int, channel: str) -> np.ndarray:
+    def neighbours(self, x: np.ndarray, category: int, channel: str, grouped: np.ndarray | None = None) -> np.ndarray:
         """Rows (into ``E_``) of the members of ``category`` nearest to input ``x``, nearest first:
-        as many as ``channel`` uses (every member for k 0 or a category that small)."""
+        as many as ``channel`` uses (every member for k 0 or a category that small).
+        ``grouped``: :meth:`_grouped` of ``x``, where the caller has it already."""
         rows = self._rows.get(int(category))
         if rows is None:
             raise KeyError(f"no members of category {category}")
@@ -187,7 +188,8 @@ class MemberEffects:
         if k == 0 or k >= rows.size:
             return rows
         start = int(self._start[int(category)])
-        return self._perm[self._grouped(x)[start: start + k]]
+        grouped = self._grouped(x) if grouped is None else grouped
+        return self._perm[grouped[start: start + k]]
 
     def means(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(mean effect per category id, shape (n_categories, n_features); which ids have
@@ -222,9 +224,10 @@ class MemberEffects:
         mean = np.zeros(len(self.effect_groups))
         spread = np.zeros(len(self.effect_groups))
         ch = np.asarray(self.effect_groups)
+        grouped = self._grouped(x)  # one distance pass for every channel
         for channel in self.channels:
             cols = ch == channel
-            e = self.effects(x, category, channel)[:, cols]
+            e = self._E[self.neighbours(x, category, channel, grouped)][:, cols]
             mean[cols], spread[cols] = e.mean(axis=0), e.std(axis=0)
         return mean, spread
 
