@@ -112,6 +112,13 @@ def test_predict_effects_option_chooses_the_members_or_the_prototype(pipeline):
     assert moved  # somewhere the members predict another move than the prototype
 
 
+def test_an_unknown_effect_model_is_refused_before_any_work(pipeline):
+    r = runner.invoke(app, ["plan", str(pipeline / "model.afford"), "--seed", "1", "--goal", "0:visibility=0",
+                            "--effects", "average"])
+    assert r.exit_code == 2 and "'average' is not one of 'members', 'prototype'" in " ".join(
+        r.output.replace("│", " ").split()), r.output
+
+
 def test_evaluate_scores_where_both_forward_models_put_things(pipeline):
     out = json.loads(runner.invoke(app, ["evaluate", str(pipeline / "model.afford"), str(pipeline / "test.afford"),
                                          "--json"]).stdout)
