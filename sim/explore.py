@@ -99,6 +99,9 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
     moving = schema.geometry
     behaviors = scene.behaviors
     n_params = max((len(b.parameters) for b in behaviors), default=0)
+    # ground truth names a shape by its index into the scene's own shapes (every shape
+    # afford knows for a scene that does not say)
+    shapes = list(getattr(getattr(scene, "config", None), "shapes", SHAPES))
     rows = _Rows([], [], [], {k: [] for k in (
         "shape", "size", "pose_before", "pose_after", "in_hand_before", "in_hand_after",
         "reachable", "contact", "outcome")})
@@ -119,7 +122,7 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
         rows.params.append(padded)
         rows.step.append(steps)
         tr = rows.truth
-        tr["shape"].append(SHAPES.index(spec.shape))
+        tr["shape"].append(shapes.index(spec.shape))
         size = np.full(3, np.nan)
         size[: len(spec.size)] = spec.size
         tr["size"].append(size)
@@ -154,7 +157,7 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
         episode=np.full(n, episode, dtype=np.int32),
         step=np.array(rows.step, dtype=np.int16),
         truth=truth,
-        shapes=list(SHAPES),
+        shapes=shapes,
         outcome_names=list(scene.outcomes),
         scene=scene.describe(),
     )

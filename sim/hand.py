@@ -29,6 +29,40 @@ _Q_NEG_Y = np.array([math.cos(math.pi / 4), 0.0, 0.0, -math.sin(math.pi / 4)])  
 _Q_Z = np.array([math.cos(-math.pi / 4), 0.0, math.sin(-math.pi / 4), 0.0])     # x -> z
 
 
+def build_gantry(ab) -> "sapien.physx.PhysxArticulationLinkBuilder":
+    """A fixed base, prismatic x, y and z joints and a revolute wrist yaw, on an articulation
+    builder; returns the wrist's child link (named ``palm``) for the hand to add its shapes
+    and fingers to. Joints are named ``gantry-x|y|z`` and ``wrist``."""
+    root = ab.create_link_builder()
+    root.set_name("base")
+    parent = root
+    for name, q in (("x", None), ("y", _Q_Y), ("z", _Q_Z)):
+        link = ab.create_link_builder(parent)
+        link.set_name(f"gantry-{name}")
+        link.set_joint_name(f"gantry-{name}")
+        qq = np.array([1.0, 0, 0, 0]) if q is None else q
+        link.set_joint_properties("prismatic", limits=[[-3.0, 3.0]],
+                                  pose_in_parent=sapien.Pose(q=qq), pose_in_child=sapien.Pose(q=qq))
+        link.set_mass_and_inertia(2.0, sapien.Pose(), np.array([0.02, 0.02, 0.02]))
+        parent = link
+    palm = ab.create_link_builder(parent)
+    palm.set_name("palm")
+    palm.set_joint_name("wrist")
+    palm.set_joint_properties("revolute", limits=[[-math.pi, math.pi]],
+                              pose_in_parent=sapien.Pose(q=_Q_Z), pose_in_child=sapien.Pose(q=_Q_Z))
+    return palm
+
+
+def clamp_to_disc(target: np.ndarray, centre, radius: float) -> np.ndarray:
+    """``target`` with its (x, y) pulled back into the disc of ``radius`` about ``centre``."""
+    t = np.array(target, dtype=float)
+    d = t[:2] - np.asarray(centre)
+    r = float(np.hypot(*d))
+    if r > radius:
+        t[:2] = np.asarray(centre) + d * (radius / r)
+    return t
+
+
 @dataclass(frozen=True)
 class HandConfig:
     """Geometry and strength of the hand (metres, newtons, kilograms)."""
@@ -63,21 +97,7 @@ class Hand:
         self.config = c = config
         material = sapien.physx.PhysxMaterial(c.friction, c.friction, 0.0)
         ab = scene.create_articulation_builder()
-        root = ab.create_link_builder()
-        root.set_name("base")
-        parent = root
-        for name, q in (("x", None), ("y", _Q_Y), ("z", _Q_Z)):
-            link = ab.create_link_builder(parent)
-            link.set_name(f"gantry-{name}")
-            qq = np.array([1.0, 0, 0, 0]) if q is None else q
-            link.set_joint_properties("prismatic", limits=[[-3.0, 3.0]],
-                                      pose_in_parent=sapien.Pose(q=qq), pose_in_child=sapien.Pose(q=qq))
-            link.set_mass_and_inertia(2.0, sapien.Pose(), np.array([0.02, 0.02, 0.02]))
-            parent = link
-        palm = ab.create_link_builder(parent)
-        palm.set_name("palm")
-        palm.set_joint_properties("revolute", limits=[[-math.pi, math.pi]],
-                                  pose_in_parent=sapien.Pose(q=_Q_Z), pose_in_child=sapien.Pose(q=_Q_Z))
+        palm = build_gantry(ab)
         palm.add_box_collision(half_size=c.palm_half, material=material, density=500)
         fingers = []
         for name, q in (("finger-left", _Q_Y), ("finger-right", _Q_NEG_Y)):
@@ -100,7 +120,15 @@ class Hand:
         for j in self.joints[4:]:
             j.set_drive_properties(stiffness=3.0e3, damping=4.0e2, force_limit=c.grip_force)
         self.body_links = [self.links[n] for n in ("palm", "finger-left", "finger-right")]
+        self.grip_links = {"left": [self.links["finger-left"]], "right": [self.links["finger-right"]]}
         self.teleport(np.array(c.home), yaw=0.0, fingers=c.finger_open)
+
+    def mesh_parts(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Each body link's surface (vertices in the link's frame, triangles), for the camera."""
+        from afford.sim.objects import box_mesh
+
+        c = self.config
+        return {link.name: box_mesh(c.palm_half if link.name == "palm" else c.finger_half) for link in self.body_links}
 
     # -- state ---------------------------------------------------------------------------
     @property
@@ -118,13 +146,7 @@ class Hand:
     def clamp_to_reach(self, target: np.ndarray) -> np.ndarray:
         """Pull a palm target back into the reachable disc."""
         c = self.config
-        t = np.array(target, dtype=float)
-        d = t[:2] - np.asarray(c.shoulder)
-        r = float(np.hypot(*d))
-        limit = c.reach + c.palm_slack
-        if r > limit:
-            t[:2] = np.asarray(c.shoulder) + d * (limit / r)
-        return t
+        return clamp_to_disc(target, c.shoulder, c.reach + c.palm_slack)
 
     def reaches(self, target: np.ndarray) -> bool:
         d = np.asarray(target[:2], dtype=float) - np.asarray(self.config.shoulder)

@@ -17,10 +17,18 @@ import open3d as o3d
 import sapien
 from afford.features.errors import DataError
 
-__all__ = ["SHAPES", "ObjectSpec", "box_mesh", "build_object", "object_mesh", "yaw_quaternion"]
+__all__ = ["SHAPES", "SOLID_SHAPES", "HANDLE", "ObjectSpec", "box_mesh", "build_object", "object_mesh",
+           "yaw_quaternion", "handle_boxes"]
 
 #: The object shapes the scenes know, in the order ground truth stores them.
-SHAPES = ("box", "cylinder", "lying-cylinder", "sphere")
+SHAPES = ("box", "cylinder", "lying-cylinder", "sphere", "mug")
+#: The shapes of chapters 5-8 (what their scenes draw from): every shape but the mug.
+SOLID_SHAPES = SHAPES[:4]
+
+#: The mug's handle, the same on every mug (thesis 9.3.4: "only the handle dimension is kept
+#: fixed"): how far it stands out from the wall, its height, the thickness of its bars and
+#: its width, metres. Its opening is 3.3 cm deep and 4.6 cm high, room for one finger.
+HANDLE = {"reach": 0.045, "height": 0.07, "bar": 0.012, "width": 0.02}
 
 # Rotation of a cylinder's local frame so that its axis (x) points up (z).
 _UPRIGHT = np.array([math.cos(-math.pi / 4), 0.0, math.sin(-math.pi / 4), 0.0])
@@ -71,11 +79,14 @@ class ObjectSpec:
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
             raise DataError(f"unknown shape {self.shape!r}; known shapes: {', '.join(SHAPES)}")
-        want = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}[self.shape]
+        want = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1, "mug": 2}[self.shape]
         if len(self.size) != want:
             raise DataError(f"a {self.shape} needs {want} size value(s), got {len(self.size)}")
         if any(not (0.01 <= s <= 1.0) for s in self.size):
             raise DataError(f"object sizes must be between 0.01 and 1.0 m, got {list(self.size)}")
+        if self.shape == "mug" and self.size[1] < HANDLE["height"] + 0.02:
+            raise DataError(f"a mug must be at least {HANDLE['height'] + 0.02:.2f} m tall to carry its handle, "
+                            f"got {self.size[1]}")
         if len(self.position) != 2:
             raise DataError("an object's position is [x, y] on the table")
         if not all(math.isfinite(v) for v in (*self.size, *self.position, self.yaw)):
@@ -90,6 +101,8 @@ class ObjectSpec:
         if self.shape == "sphere":
             return np.array([s[0]] * 3, dtype=float)
         d, length = s
+        if self.shape == "mug":  # the handle on local +x: bounded as if it stood out both ways
+            return np.array([d + 2 * HANDLE["reach"], d, length], dtype=float)
         if self.shape == "cylinder":
             return np.array([d, d, length], dtype=float)
         return np.array([length, d, d], dtype=float)  # lying: axis along local x
@@ -119,7 +132,10 @@ class ObjectSpec:
             return float(s[0] * s[1] * s[2])
         if self.shape == "sphere":
             return float(math.pi * s[0] ** 3 / 6)
-        return float(math.pi * (s[0] / 2) ** 2 * s[1])
+        solid = float(math.pi * (s[0] / 2) ** 2 * s[1])
+        if self.shape == "mug":
+            solid += sum(float(np.prod(2 * np.asarray(h))) for _, h in handle_boxes(s[0]))
+        return solid
 
     def to_dict(self) -> dict:
         return {"shape": self.shape, "size": list(self.size), "position": list(self.position),
@@ -131,7 +147,20 @@ class ObjectSpec:
                            yaw_quaternion(self.yaw))
 
     def _local_rotation(self) -> np.ndarray:
-        return _UPRIGHT if self.shape == "cylinder" else np.array([1.0, 0.0, 0.0, 0.0])
+        return _UPRIGHT if self.shape in ("cylinder", "mug") else np.array([1.0, 0.0, 0.0, 0.0])
+
+
+def handle_boxes(diameter: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The mug handle's three convex pieces as (centre, half extents) in the mug's frame
+    (z up, the handle on +x): an upper and a lower arm from inside the wall outwards, and
+    the bar that joins them."""
+    r, h = diameter / 2, HANDLE
+    arm_len = h["reach"] + 0.006
+    half_arm = np.array([arm_len / 2, h["width"] / 2, h["bar"] / 2])
+    arm_x = r - 0.006 + arm_len / 2
+    zc = h["height"] / 2 - h["bar"] / 2
+    bar = (np.array([r + h["reach"] - h["bar"] / 2, 0.0, 0.0]), np.array([h["bar"] / 2, h["width"] / 2, h["height"] / 2]))
+    return [(np.array([arm_x, 0.0, zc]), half_arm), (np.array([arm_x, 0.0, -zc]), half_arm), bar]
 
 
 @dataclass
@@ -166,6 +195,12 @@ def build_object(scene: sapien.Scene, spec: ObjectSpec, table_top: float, densit
     let it roll when pushed across its axis.
     """
     body = sapien.physx.PhysxRigidDynamicComponent()
+    extra = []
+    if spec.shape == "mug":  # one actor: the cup and its handle's three pieces
+        for centre, half in handle_boxes(spec.size[0]):
+            piece = sapien.physx.PhysxCollisionShapeBox(half_size=half, material=material)
+            piece.local_pose = sapien.Pose(centre)
+            extra.append(piece)
     if spec.shape == "box":
         shape = sapien.physx.PhysxCollisionShapeBox(half_size=np.array(spec.size) / 2, material=material)
     elif spec.shape == "sphere":
@@ -174,8 +209,9 @@ def build_object(scene: sapien.Scene, spec: ObjectSpec, table_top: float, densit
         shape = sapien.physx.PhysxCollisionShapeConvexMesh(
             vertices=_prism(spec.size[0] / 2, spec.size[1]), scale=np.ones(3, dtype=np.float32), material=material)
         shape.local_pose = sapien.Pose(q=spec._local_rotation())
-    shape.set_density(density)
-    body.attach(shape)
+    for part in [shape, *extra]:
+        part.set_density(density)
+        body.attach(part)
     entity = sapien.Entity()
     entity.name = f"object-{spec.shape}"
     entity.add_component(body)
@@ -195,6 +231,13 @@ def object_mesh(spec: ObjectSpec) -> tuple[np.ndarray, np.ndarray]:
         mesh.translate(-np.array(spec.size) / 2)
     elif spec.shape == "sphere":
         mesh = o3d.geometry.TriangleMesh.create_sphere(radius=spec.size[0] / 2, resolution=16)
+    elif spec.shape == "mug":
+        mesh = o3d.geometry.TriangleMesh.create_cylinder(radius=spec.size[0] / 2, height=spec.size[1],
+                                                         resolution=CYLINDER_SIDES, split=1)
+        for centre, half in handle_boxes(spec.size[0]):
+            piece = o3d.geometry.TriangleMesh.create_box(*(2 * half))
+            piece.translate(centre - half)
+            mesh += piece
     else:
         # Open3D's cylinder stands along z; rotate it onto the body's local axis.
         mesh = o3d.geometry.TriangleMesh.create_cylinder(radius=spec.size[0] / 2, height=spec.size[1],

@@ -69,7 +69,7 @@ from afford.features import RangeImage
 from afford.features.errors import DataError
 from afford.sim.camera import MeshInstance
 from afford.sim.layout import LayoutError
-from afford.sim.objects import SHAPES, ObjectSpec, box_mesh, build_object, object_mesh, yaw_quaternion
+from afford.sim.objects import SHAPES, SOLID_SHAPES, ObjectSpec, box_mesh, build_object, object_mesh, yaw_quaternion
 from afford.sim.robots.mobile import MobileRobot, MobileRobotConfig, Odometry
 from afford.sim.scanner import RangeScanner, ScannerConfig
 
@@ -370,7 +370,7 @@ def _round(v: float) -> float:
 
 def sample_clutter(rng: np.random.Generator, max_objects: int = 12, size_range: tuple[float, float] = (0.10, 0.40),
                    x_range: tuple[float, float] = (0.3, 2.0), y_range: tuple[float, float] = (-1.0, 1.0),
-                   shapes: tuple[str, ...] = SHAPES, robot: MobileRobotConfig = MobileRobotConfig()) -> TraverseLayout:
+                   shapes: tuple[str, ...] = SOLID_SHAPES, robot: MobileRobotConfig = MobileRobotConfig()) -> TraverseLayout:
     """0-``max_objects`` loose objects of random shape, size, place and yaw (thesis 5.6.1)."""
     lo, hi = size_range
     if not (0.01 <= lo <= hi <= 1.0):

@@ -14,11 +14,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import sapien
 
-from afford.features import RegionOfInterest, perceive, track
+from afford.features import RegionOfInterest, object_schema, perceive, track
 from afford.features.detect import detect_objects
 from afford.features.errors import DataError
 from afford.features.interactions import OUTCOMES
-from afford.features.objects import N_OBJECT_FEATURES
 from afford.features.objects import centres as object_centres
 from afford.sim.camera import CameraConfig, MeshInstance, RangeCamera
 from afford.sim.hand import Hand, HandConfig
@@ -103,9 +102,8 @@ class TableWorld:
         tb.set_initial_pose(table_pose)
         self.table = tb.build_static(name="table")
         self._table_mesh = (*box_mesh(half_table), np.asarray(table_pose.p), np.array([1.0, 0, 0, 0]))
-        self.hand = Hand(self.scene, c.hand)
-        self._hand_meshes = {link.name: box_mesh(c.hand.palm_half if link.name == "palm" else c.hand.finger_half)
-                             for link in self.hand.body_links}
+        self.hand = self._make_hand()
+        self._hand_meshes = self.hand.mesh_parts()
         self.specs = list(objects)
         self.bodies = [build_object(self.scene, s, c.table_top, c.density, material) for s in objects]
         self.components = [b.find_component_by_type(sapien.physx.PhysxRigidDynamicComponent) for b in self.bodies]
@@ -125,8 +123,25 @@ class TableWorld:
             raise DataError("the hand can hold only one object")
         if held:
             self._start_held(held[0])
-        self.known = np.empty((0, N_OBJECT_FEATURES))
+        self.known = np.empty((0, len(self.schema)))
         self.identity: list[int] = []
+
+    # -- what a world of another hand or perception replaces ------------------------------------
+    schema = object_schema()
+
+    def _make_hand(self):
+        return Hand(self.scene, self.config.hand)
+
+    def _features(self, image) -> np.ndarray:
+        """The entities in a range image: (k, d) feature vectors."""
+        return perceive(image, self.config.roi())
+
+    def _positions(self, features: np.ndarray) -> np.ndarray:
+        """Where perceived objects are (k, 3), for tracking and ground truth."""
+        return object_centres(features)
+
+    def _track(self, known: np.ndarray, seen: np.ndarray) -> np.ndarray:
+        return track(known, seen)
 
     # -- physics ---------------------------------------------------------------------------
     def step(self, n: int = 1, watch_contacts: bool = False) -> None:
@@ -207,7 +222,7 @@ class TableWorld:
         """Detect the objects in view now: (k, 43) feature vectors."""
         image = self.camera.capture(self.meshes(), self.rng)
         self.last_image = image
-        return perceive(image, self.config.roi())
+        return self._features(image)
 
     def last_view(self, image=None) -> tuple[np.ndarray, list[tuple[int, int, int, int]]] | None:
         """The last range image (or ``image``, an earlier look's) as (H, W) ranges (inf where
@@ -230,7 +245,7 @@ class TableWorld:
             self.known = seen
             self._identify(seen)
         else:
-            self.known = track(self.known, seen)
+            self.known = self._track(self.known, seen)
         return self.known.copy()
 
     # -- ground truth ----------------------------------------------------------------------
@@ -241,7 +256,7 @@ class TableWorld:
         if seen.shape[0] == 0 or not self.bodies:
             self.identity = []
             return
-        centres = object_centres(seen)[:, :2]
+        centres = self._positions(seen)[:, :2]
         true = np.array([np.asarray(b.pose.p[:2]) for b in self.bodies])
         cost = np.linalg.norm(centres[:, None, :] - true[None, :, :], axis=2)
         rows, cols = linear_sum_assignment(cost)
@@ -260,18 +275,18 @@ class TableWorld:
         return [truth[i] for i in self.identity]
 
     def truth(self) -> list[ObjectTruth]:
-        fingers = {self.hand.links["finger-left"], self.hand.links["finger-right"]}
+        finger_of = {link: name for name, links in self.hand.grip_links.items() for link in links}
         touching: dict[int, set] = {i: set() for i in range(len(self.components))}
         index = {comp: i for i, comp in enumerate(self.components)}
         for contact in self.scene.get_contacts():
             a, b = contact.bodies
             for x, y in ((a, b), (b, a)):
-                if x in index and y in fingers:
-                    touching[index[x]].add(y)
+                if x in index and y in finger_of:
+                    touching[index[x]].add(finger_of[y])
         out = []
         for i, comp in enumerate(self.components):
             pose = comp.entity_pose
             lo, _ = comp.compute_global_aabb_tight()
             out.append(ObjectTruth(np.asarray(pose.p, dtype=float), np.asarray(pose.q, dtype=float),
-                                   float(lo[2]), len(touching[i]) == 2))
+                                   float(lo[2]), len(touching[i]) >= 2))
         return out

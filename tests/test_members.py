@@ -59,6 +59,35 @@ def test_member_effects_fall_back_on_the_prototype_when_features_tell_nothing():
     assert errors[k] <= min(errors[3], errors[5])
 
 
+def test_nearest_members_are_those_a_full_stable_sort_finds_ties_included():
+    """The partial sort that planning uses picks, per category, the same nearest members in the
+    same order as sorting every member by distance (ties: the lower row), one query or many."""
+    rng = np.random.default_rng(4)
+    X, E, labels = _planted(400, rng)
+    X[10:40] = X[5]  # thirty members at exactly one distance from any query: ties at the k-th
+    labels = rng.integers(0, 3, labels.size)
+    m = _members(X, E, labels, k_grid=(3, 5))
+    queries = np.vstack([rng.uniform(0, 1, (20, 2)), X[5:6], X[[3, 70]]])
+    for x in queries:
+        # the distances exactly as the model computes them, then every member sorted
+        d = np.empty(labels.size)
+        d[m._perm] = m._sq - 2.0 * (((x - m.shift_) * m.weight_) @ m._ZT)
+        for c in range(3):
+            rows = np.flatnonzero(labels == c)
+            for channel in m.channels:
+                k = m.k_[channel]
+                want = rows[np.argsort(d[rows], kind="stable")[:k]] if k else rows
+                assert np.array_equal(m.neighbours(x, c, channel), want)
+    batched, _ = m.means(queries)  # many queries take the partial sort; one query the full one
+    assert np.array_equal(batched, np.stack([m.means(x)[0] for x in queries]))
+    grouped = m._grouped(queries)
+    for q, x in enumerate(queries):
+        single = m._grouped(x)
+        for start, count in m._blocks:
+            k = min(count, m._kmax)
+            assert np.array_equal(grouped[q, start: start + k], single[start: start + k])
+
+
 def test_member_effects_round_trip_through_plain_arrays_and_refuse_parts_that_do_not_fit():
     rng = np.random.default_rng(3)
     X, E, labels = _planted(300, rng)

@@ -43,7 +43,7 @@ from afford.features.errors import DataError
 from afford.features.image_objects import image_object_schema
 from afford.sim.behaviors import Behavior, Execution
 from afford.sim.crane import CRANE_OUTCOMES, DRIVE, CraneWorld, CraneWorldConfig
-from afford.sim.objects import SHAPES
+from afford.sim.objects import SOLID_SHAPES as SHAPES
 from afford.sim.registry import register_scene
 from afford.sim.traverse import Item, TraverseLayout, TraverseLayoutFiles, _rects_overlap, _robot_footprint, check_layout
 

@@ -40,7 +40,7 @@ from afford.features.interactions import OUTCOMES
 from afford.sim.behaviors import TABLE_BEHAVIORS
 from afford.sim.camera import RangeCamera
 from afford.sim.layout import layout_toml, parse_layout
-from afford.sim.objects import SHAPES, ObjectSpec
+from afford.sim.objects import SHAPES, SOLID_SHAPES, ObjectSpec
 from afford.sim.registry import register_scene
 from afford.sim.world import TableConfig, TableWorld
 
@@ -53,7 +53,7 @@ class TableSceneConfig:
 
     size_range: tuple[float, float] = (0.08, 0.40)
     """Each object dimension is uniform in this range (metres)."""
-    shapes: tuple[str, ...] = SHAPES
+    shapes: tuple[str, ...] = SOLID_SHAPES
     """Shapes to draw from, equally likely."""
     world: TableConfig = field(default_factory=TableConfig)
     """Table, hand, camera and physics settings."""

@@ -37,7 +37,7 @@ import numpy as np
 
 from afford.features.errors import DataError
 from afford.sim.moves import TraverseScene
-from afford.sim.objects import SHAPES
+from afford.sim.objects import SOLID_SHAPES as SHAPES
 from afford.sim.registry import register_scene
 from afford.sim.traverse import Item, TraverseLayout, _rects_overlap, check_layout
 
