@@ -163,7 +163,8 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
     arrays, meta, blobs = features_members(art, data, relevance, settings)
     write_artifact(output, artifact_bytes("features", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     return {"output": output, "seconds": round(time.perf_counter() - start, 3), "method": method,
-            "behaviors": {n: {"selected": r["selected"]} for n, r in meta["relevance"].items()}}
+            "behaviors": {n: {"selected": r["selected"], **({"parameters": r["parameters"]} if "parameters" in r else {})}
+                          for n, r in meta["relevance"].items()}}
 
 
 def train(path: str, output: str, *, kernel: str | None = None, folds: int | None = None, seed: int = 0,
@@ -352,22 +353,28 @@ class Model(LoadedModel):
     Attributes: ``names`` (behaviours), ``schema`` (its ``names`` are the feature names),
     ``label_source`` (``discovered`` or ``given``), ``result_names``, ``selected``, and
     ``effect_model``: how :meth:`forward` predicts a category's effect on an entity unless
-    told (``members``, or ``prototype`` for the thesis's; set it to compare).
+    told (``members``, or ``prototype`` for the thesis's; set it to compare); ``alpha_rule``:
+    how it chooses a behaviour's parameter (``group``, ``probability`` or ``grid``).
     """
 
     effect_model = "members"
+    alpha_rule = "group"
 
-    def forward(self, min_probability: float = 0.02, effects: str | None = None):
+    def forward(self, min_probability: float = 0.02, effects: str | None = None, alpha_rule: str | None = None):
         """The planner's forward model (outcomes below ``min_probability`` are dropped).
         ``effects``: ``members`` (each entity's own effect within its category, the default)
-        or ``prototype`` (the thesis's category means); None keeps :attr:`effect_model`."""
+        or ``prototype`` (the thesis's category means); None keeps :attr:`effect_model`.
+        ``alpha_rule``: how a one-parameter behaviour's parameter is chosen (``group``,
+        thesis 9.5, the default; ``probability``; ``grid``); None keeps :attr:`alpha_rule`."""
         effects = self.effect_model if effects is None else effects
+        alpha_rule = self.alpha_rule if alpha_rule is None else alpha_rule
         cache = self.__dict__.setdefault("_forward", {})
-        if (min_probability, effects) not in cache:
+        if (min_probability, effects, alpha_rule) not in cache:
             from afford.learning import forward_model
 
-            cache[min_probability, effects] = forward_model(self, min_probability=min_probability, effects=effects)
-        return cache[min_probability, effects]
+            cache[min_probability, effects, alpha_rule] = forward_model(
+                self, min_probability=min_probability, effects=effects, alpha_rule=alpha_rule)
+        return cache[min_probability, effects, alpha_rule]
 
     def _rows(self, X) -> np.ndarray:
         X = np.atleast_2d(np.asarray(X, dtype=float))
@@ -415,7 +422,14 @@ class Model(LoadedModel):
             entry = {"object": i, "visible": seen, "features": _named(schema, f), "behaviors": {}}
             if seen:
                 for b, name in enumerate(self.names):
-                    classes, proba = fm.distribution(f, b, ())
+                    # a behaviour with a parameter: the planner tries the alphas its rule
+                    # chose (one per next state); shown is the one whose outcome is surest,
+                    # with every choice beside it
+                    alphas = fm.alpha_choices(f, b) if fm.behaviors[b].parameters else [()]
+                    dists = [fm.distribution(f, b, a) for a in alphas]
+                    pick = int(np.argmax([d[1].max() for d in dists]))
+                    alpha = alphas[pick]
+                    classes, proba = dists[pick]
                     best = int(classes[np.argmax(proba)])
                     p = {"category": best, "probability": round(float(proba.max()), 4),
                          "probabilities": {str(int(c)): round(float(q), 4) for c, q in zip(classes, proba)},
@@ -426,11 +440,16 @@ class Model(LoadedModel):
                     else:
                         obj = SCENE if fm.behaviors[b].target is None else i
                         cats = [best if j == i else None for j in range(state.shape[0])] if obj == SCENE else best
-                        nxt = fm.apply(state, obj, b, cats)[i]
+                        nxt = fm.apply(state, obj, b, cats, alpha)[i]
                         # how far the members the prediction rests on scattered (the spread of the effect)
-                        spread = fm.spread(f, b, best)
+                        spread = fm.spread(f, b, best, alpha)
                         p["next"] = {"visible": bool(schema.visible(nxt)), "features": _named(schema, nxt),
                                      "spread": _named(schema, spread)}
+                    if alpha:
+                        p["alpha"] = [round(float(a), 3) for a in alpha]
+                        p["choices"] = [{"alpha": [round(float(v), 3) for v in a],
+                                         "category": int(d[0][np.argmax(d[1])]), "probability": round(float(d[1].max()), 4)}
+                                        for a, d in zip(alphas, dists)]
                     entry["behaviors"][name] = p
             out.append(entry)
         return out

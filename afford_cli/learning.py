@@ -112,6 +112,10 @@ def features_members(art: Artifact, data: Interactions, relevance: dict, setting
         arrays[f"relevance.{name}"] = np.asarray(fr.scores_, dtype=np.float32)
         summary[name] = {**settings, "selected": [data.schema.names[i] for i in fr.selected_],
                          "scores": {data.schema.names[i]: round(float(fr.scores_[i]), 5) for i in fr.ranking_}}
+        if getattr(fr, "parameter_scores_", None):
+            # the behaviour's parameters were candidates too: their score and rank among the features
+            summary[name]["parameters"] = {p: {"score": round(score, 5), "rank": rank}
+                                           for p, (score, rank) in fr.parameter_scores_.items()}
     meta["relevance"] = summary
     return arrays, meta, dict(art.blobs)
 
@@ -310,7 +314,7 @@ def load_model(path: str):
     return Model(read_artifact(path, "model"))
 
 
-def forward_model(model: LoadedModel, min_probability: float = 0.02, effects: str = "members"):
+def forward_model(model: LoadedModel, min_probability: float = 0.02, effects: str = "members", alpha_rule: str = "group"):
     """The planner's forward model of a loaded model artefact (``effects``: ``members`` or
     ``prototype``, :class:`afford.plan.forward.ForwardModel`)."""
     from afford.plan.forward import BehaviorModel, ForwardModel
@@ -323,4 +327,4 @@ def forward_model(model: LoadedModel, min_probability: float = 0.02, effects: st
                                        known=model.known[name], known_selected=model.known_selected[name],
                                        periodic=tuple(bool(p.get("periodic")) for p in spec.get("parameters", [])),
                                        target=spec.get("target", "object"), members=model.members[name]))
-    return ForwardModel(behaviors, model.schema, min_probability=min_probability, effects=effects)
+    return ForwardModel(behaviors, model.schema, min_probability=min_probability, effects=effects, alpha_rule=alpha_rule)

@@ -41,6 +41,18 @@ Effects = Annotated[EffectModel, typer.Option(
                       "(members), or the category's mean for every object (prototype, the thesis's model).")]
 
 
+class AlphaRule(str, Enum):
+    group = "group"
+    probability = "probability"
+    grid = "grid"
+
+
+AlphaRuleOpt = Annotated[AlphaRule, typer.Option(
+    "--alpha-rule", help="How a behaviour's parameter (chapter 9's approach angle) is chosen: the mean of the largest "
+                         "group of grid angles leading to each next state (group, thesis 9.5), the angle that makes "
+                         "each next state most probable (probability), or every point of a 5-point grid (grid).")]
+
+
 # -- where a command acts: a drawn scene or a pinned layout, and the planner's limits ------
 SceneSeed = Annotated[Optional[int], typer.Option("--seed", "-s", min=0, help="Draw a random scene from this seed.")]
 Objects = Annotated[Optional[int], typer.Option("--objects", min=1, max=6, help="Objects in a drawn scene (scenes that have objects to act on).")]

@@ -11,6 +11,7 @@ normals, histograms, tracking). The traverse scenes: world build, the scan (720 
 rays cast with Open3D, noise, min-downscale), physics (the robot's moves) and the grid
 features. ``crane-lift``: the same stages, physics being the moves, the crane's lifts and
 settling, features the background subtraction, segmentation and the 44 features.
+``grasp``: the table's stages, features being chapter 9's contact-point features.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from benchmarks._common import emit  # noqa: E402
 import afford.features.objects as fobj  # noqa: E402
 import afford.sim.camera as cam  # noqa: E402
 import afford.sim.crane as crane  # noqa: E402
+import afford.sim.grasp as grasp  # noqa: E402
 import afford.sim.moves as moves  # noqa: E402
 import afford.sim.robots.mobile as mobile  # noqa: E402
 import afford.sim.scanner as scanner  # noqa: E402
@@ -161,18 +163,21 @@ def breakdown(scene, episodes: int, seed: int) -> dict:
                 totals[key] += time.perf_counter() - t
         return wrapper
 
-    saved = (world.TableWorld.__init__, cam.RangeCamera.capture, world.TableWorld.step, world.perceive, world.track)
+    saved = (world.TableWorld.__init__, cam.RangeCamera.capture, world.TableWorld.step, world.perceive, world.track,
+             grasp.perceive_contact_points)
     world.TableWorld.__init__ = timed("world_build", saved[0])
     cam.RangeCamera.capture = timed("ray_casting", saved[1])
     world.TableWorld.step = timed("physics", saved[2])
     world.perceive = timed("features", saved[3])
     world.track = timed("features", saved[4])
+    grasp.perceive_contact_points = timed("features", saved[5])
     try:
         start = time.perf_counter()
         rows = sum(len(run_episode(scene, seed, e)) for e in range(episodes))
         total = time.perf_counter() - start
     finally:
-        (world.TableWorld.__init__, cam.RangeCamera.capture, world.TableWorld.step, world.perceive, world.track) = saved
+        (world.TableWorld.__init__, cam.RangeCamera.capture, world.TableWorld.step, world.perceive, world.track,
+         grasp.perceive_contact_points) = saved
     # world build includes the initial settle of a held object (physics), counted once each
     out = {k: round(1000 * v / rows, 2) for k, v in totals.items()}
     out["other"] = round(1000 * total / rows - sum(out.values()), 2)
@@ -184,7 +189,7 @@ def main() -> None:
     ap.add_argument("--interactions", type=int, default=1000, help="per throughput run on the table")
     ap.add_argument("--traverse-interactions", type=int, default=700, help="per throughput run on a mobile-robot scene")
     ap.add_argument("--backend-interactions", type=int, default=2000, help="per run comparing loky, Dask and a resume")
-    ap.add_argument("--scenes", default="table,traverse,traverse-body,traverse-ramps,traverse-gaps,crane-lift")
+    ap.add_argument("--scenes", default="table,traverse,traverse-body,traverse-ramps,traverse-gaps,crane-lift,grasp")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "explore.json"))
     args = ap.parse_args()
@@ -198,6 +203,12 @@ def main() -> None:
         if name == "table":
             continue
         sc = make_scene(name)
+        if name == "grasp":  # a play scene on the chapter-8 world: the table's breakdown
+            result[name] = {
+                "throughput": [throughput(sc, args.interactions, w, args.seed) for w in (1, 2)],
+                "breakdown_one_worker": breakdown(sc, episodes=max(20, args.interactions // 5), seed=args.seed),
+            }
+            continue
         result[name] = {
             "throughput": [throughput(sc, args.traverse_interactions, w, args.seed) for w in (1, 2)],
             "breakdown_one_worker": scan_breakdown(sc, episodes=20, seed=args.seed),

@@ -19,6 +19,8 @@ lift), breadth-first chaining to depth 4 in layouts of 5 objects, as ``afford pl
 bfs --max-depth 4`` runs it: for the thesis's goal ``*:r_b>180`` (some object lifted) and for
 one that never holds (``*:r_b>400``), which makes the search build the whole depth-4 tree
 (its node budget, 20 000, permitting); seconds per plan and nodes per second.
+``grasp_alpha_choice``: chapter 9's choice of alpha for one object and behaviour over a
+36-point grid, by the largest-group rule and by the most probable alpha (milliseconds).
 Prints one JSON object and writes it to ``--out``.
 """
 
@@ -87,6 +89,44 @@ def crane(episodes: int, layouts: int, seed: int) -> dict:
     return out
 
 
+def alpha_choice(model_path: str | None, interactions: int, scenes: int, seed: int) -> dict:
+    """Chapter 9: the cost of choosing alpha for one object and behaviour over the 36-point
+    grid (thesis 9.5's largest group, and the most probable alpha), on random grasp scenes,
+    each choice with a fresh cache (it pays for its 36 predictions)."""
+    import afford
+    from afford.learning import forward_model
+
+    t = time.perf_counter()
+    built = None
+    if model_path is None:
+        d = Path(tempfile.mkdtemp(prefix="afford-bench-grasp-"))
+        data = afford.explore("grasp", interactions=interactions, seed=seed, workers=2)
+        afford.save(data, str(d / "i.afford"), seed=seed)
+        afford.cluster(str(d / "i.afford"), str(d / "e.afford"), seed=seed)
+        afford.select_features(str(d / "e.afford"), str(d / "f.afford"), seed=seed)
+        afford.train(str(d / "f.afford"), str(d / "m.afford"), seed=seed)
+        model_path = str(d / "m.afford")
+        built = round(time.perf_counter() - t, 1)
+    model = afford.load_model(model_path)
+    out = {"model_build_seconds": built, "interactions": interactions if built else None, "grid": 36}
+    for rule in ("group", "probability"):
+        ms = []
+        for i in range(scenes):
+            state = afford.world("grasp", seed=seed + 500 + i).perceive()
+            for f in state:
+                for b, behavior in enumerate(model.forward().behaviors):
+                    if len(behavior.parameters) != 1:
+                        continue
+                    fm = forward_model(model, alpha_rule=rule)
+                    t0 = time.perf_counter()
+                    fm.choose_alphas(f, b)
+                    ms.append(1000 * (time.perf_counter() - t0))
+        ms = np.asarray(ms)
+        out[rule] = {"choices": int(ms.size), "ms_mean": round(float(ms.mean()), 2) if ms.size else None,
+                     "ms_max": round(float(ms.max()), 2) if ms.size else None}
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model")
@@ -97,6 +137,8 @@ def main() -> None:
     ap.add_argument("--crane-layouts", type=int, default=10)
     ap.add_argument("--effects", default="members", choices=["members", "prototype"],
                     help="the forward model's effects (members: each object's own; prototype: the thesis's)")
+    ap.add_argument("--grasp-model", help="a grasp model for the alpha-choice timing (default: explore and train one)")
+    ap.add_argument("--grasp-interactions", type=int, default=3000, help="grasp interactions to learn from (0: skip)")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "plan.json"))
     args = ap.parse_args()
     t = time.perf_counter()
@@ -198,6 +240,8 @@ def main() -> None:
         }
     if args.crane_episodes:
         result["crane"] = crane(args.crane_episodes, args.crane_layouts, args.seed)
+    if args.grasp_model or args.grasp_interactions:
+        result["grasp_alpha_choice"] = alpha_choice(args.grasp_model, args.grasp_interactions, 10, args.seed)
     emit(result, args.out)
 
 

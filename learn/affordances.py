@@ -115,18 +115,64 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
     (``kernel``: an RBF machine, or a linear one as chapter 5's)."""
     out = {}
     groups = feature_groups(data.schema) if group_channels else None
+    _check_some_differ(data, labels, "tell apart")
     for b, name in enumerate(data.behavior_names):
         rows = behaviour_rows(data, b, labels)
         _check_rows(data, b, rows, "feature selection")
         y = labels[rows]
-        if np.unique(y).size < 2:
-            raise DataError(f"behaviour {name!r} has {_one_label(data)}; there is nothing to tell apart")
-        fr = FeatureRelevance(method=method, top=top, feature_groups=groups, random_state=behaviour_seed(seed, b),
+        X = data.before_rows(rows)
+        d = X.shape[1]
+        params = parameters_of(data, b)
+        A = encode_parameters(data.params[rows], params) if params else np.zeros((len(rows), 0))
+        g = groups
+        if A.shape[1]:  # the parameters are candidates too (fig 9.7), each one unit (sine and cosine together)
+            X = np.hstack([X, A])
+            if g is not None:
+                g = np.concatenate([g, _parameter_units(params, int(g.max()) + 1)])
+        fr = FeatureRelevance(method=method, top=top, feature_groups=g, random_state=behaviour_seed(seed, b),
                               estimator=prefix_estimator(kernel) if method == "relieff" else None)
-        out[name] = fr.fit(data.before_rows(rows), y)
+        out[name] = _split_parameters(fr.fit(X, y), d, params)
         if progress is not None:
             progress(b + 1)
     return out
+
+
+def _parameter_units(params: list[dict], first: int) -> np.ndarray:
+    """A unit label per encoded parameter column: a periodic parameter's sine and cosine share one."""
+    return np.concatenate([np.full(2 if p.get("periodic") else 1, first + j) for j, p in enumerate(params)]).astype(int)
+
+
+def _split_parameters(fr: FeatureRelevance, d: int, params: list[dict]) -> FeatureRelevance:
+    """Keep the entity features' part of a relevance fitted on entity features and encoded
+    parameters (the predictor is always given the parameters), and record each parameter's
+    score and rank among the entity features (``parameter_scores_``: name -> (score, rank),
+    rank 1 the most relevant)."""
+    fr.parameter_scores_ = {}
+    if not params:
+        return fr
+    units = _parameter_units(params, 0)
+    order = [int(i) for i in fr.ranking_]
+    for j, p in enumerate(params):
+        cols = d + np.flatnonzero(units == j)
+        first = min(order.index(int(c)) for c in cols)
+        rank = 1 + sum(1 for i in order[:first] if i < d)
+        fr.parameter_scores_[str(p.get("name", f"alpha{j}"))] = (float(np.max(fr.scores_[cols])), rank)
+    fr.selected_ = np.asarray([i for i in fr.selected_ if i < d], dtype=int)
+    fr.ranking_ = np.asarray([i for i in order if i < d], dtype=int)
+    fr.scores_ = np.asarray(fr.scores_[:d])
+    return fr
+
+
+def _check_some_differ(data: Interactions, labels: np.ndarray, what: str) -> None:
+    """Refuse, in one sentence, data in which no behaviour has two effects to tell apart
+    (counting only those of two or more interactions: a lone member cannot be learned from).
+    A behaviour that alone always had one effect is learned as certain of it."""
+    for b in range(len(data.behavior_names)):
+        y = labels[behaviour_rows(data, b, labels)]
+        if (np.unique(y, return_counts=True)[1] >= 2).sum() >= 2:
+            return
+    raise DataError(f"every behaviour has {_one_label(data)} (counting only those of two or more interactions); "
+                    f"there is nothing to {what}")
 
 
 def _one_label(data: Interactions) -> str:
@@ -213,13 +259,15 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
     ``folds``: the cross-validation that chooses C (and gamma) and reports the accuracy
     (3 at the table; the thesis's chapter 5 reported 5-fold cross-validation)."""
     out = {}
+    _check_some_differ(data, labels, "predict")
     for b, name in enumerate(data.behavior_names):
         rows = behaviour_rows(data, b, labels)
         _check_rows(data, b, rows, "training")
         y = labels[rows]
-        if (np.unique(y, return_counts=True)[1] >= 2).sum() < 2:  # a lone member cannot be learned from
-            raise DataError(f"behaviour {name!r} has {_one_label(data)} (counting only those of two or more "
-                            "interactions); there is nothing to predict")
+        values, counts = np.unique(y, return_counts=True)
+        if (counts >= 2).sum() < 2:  # one effect to speak of (lone members cannot be learned from): certain of it
+            rows = rows[np.isin(y, values[counts == counts.max()][:1])]
+            y = labels[rows]
         X = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b))
         out[name] = AffordancePredictor(kernel=kernel, cv=folds, n_jobs=n_jobs,
                                         random_state=behaviour_seed(seed, b)).fit(X, y)

@@ -246,10 +246,13 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         check_classification_targets(y)
         self.classes_, y_idx = np.unique(y, return_inverse=True)
         if self.classes_.size < 2:
-            raise DataError(
-                "AffordancePredictor needs at least two effect categories to learn from, "
-                f"but y holds only one class ({self.classes_[0]!r})."
-            )
+            # A behaviour that always had the same effect (chapter 9's open-hand on an empty
+            # table: nothing happens) predicts that effect, with certainty, whatever it sees.
+            self.calibrated_ = None
+            self.cv_report_ = {"constant": True, "best_params": {}, "cv_accuracy": 1.0, "cv_accuracy_std": 0.0,
+                               "grid": [], "n_splits": 0, "class_counts": {str(self.classes_[0]): int(y_idx.size)},
+                               "singleton_classes": []}
+            return self
         folds = self._folds(y_idx)
 
         if self.kernel == "rbf":
@@ -325,6 +328,8 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64, ensure_all_finite=False)
         check_finite(X)
+        if self.calibrated_ is None:  # one category only: it is certain
+            return np.ones((X.shape[0], 1))
         proba = np.zeros((X.shape[0], self.classes_.size))
         proba[:, self.calibrated_.classes_] = self.calibrated_.predict_proba(X)
         return proba
@@ -447,6 +452,8 @@ def fast_predict_proba(predictor: AffordancePredictor):
     """
     check_is_fitted(predictor)
     cc = predictor.calibrated_
+    if cc is None:  # one category only
+        return lambda X: np.ones((len(X), 1))
     pipe = cc.calibrated_classifiers_[0].estimator if not cc.ensemble else None
     if pipe is None or not isinstance(pipe.named_steps.get("svc"), OneVsRestClassifier):
         return predictor.predict_proba

@@ -566,9 +566,15 @@ class FeatureRelevance(BaseEstimator):
         """
         self._validate_params()
         X = validate_data(self, X, dtype=np.float64, ensure_all_finite=False)
-        X, y, _, _ = _check_Xy(X, y)
         d = X.shape[1]
         self.path_ = []
+        if np.asarray(y).ndim == 1 and len(y) == X.shape[0] and np.unique(y).size == 1:
+            check_finite(X)  # one category: no feature tells anything apart
+            self.scores_ = np.zeros(d)
+            self.ranking_ = np.arange(d)
+            self.selected_ = np.zeros(0, dtype=int)
+            return self
+        X, y, _, _ = _check_Xy(X, y)
         if self.method == "relieff":
             self.scores_ = relieff(X, y, self.n_samples, self.n_neighbors, self.random_state)
             self.ranking_ = np.argsort(-self.scores_, kind="stable")

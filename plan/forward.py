@@ -25,7 +25,10 @@ import numpy as np
 from afford.features import encode_parameters
 from afford.features.errors import DataError
 
-__all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE", "EFFECT_MODELS"]
+__all__ = ["BehaviorModel", "ForwardModel", "Outcome", "SCENE", "EFFECT_MODELS", "ALPHA_RULES"]
+
+#: How the planner picks a behaviour's parameter (``ForwardModel(alpha_rule=...)``).
+ALPHA_RULES = ("grid", "group", "probability")
 
 #: How a category's effect on one entity is predicted (``ForwardModel(effects=...)``).
 EFFECT_MODELS = ("members", "prototype")
@@ -67,6 +70,31 @@ def _as_slice(index: np.ndarray):
     return index
 
 
+def _largest_run(mask: np.ndarray, circle: bool) -> np.ndarray:
+    """Indices of the longest run of True in ``mask`` (wrapping round if ``circle``); the
+    first of equally long ones."""
+    n = mask.size
+    if mask.all():
+        return np.arange(n)
+    start = int(np.argmin(mask)) if circle else 0  # begin on a False so no run is cut in two
+    order = (np.arange(n) + start) % n if circle else np.arange(n)
+    best, run = [], []
+    for i in order:
+        if mask[i]:
+            run.append(int(i))
+            if len(run) > len(best):
+                best = list(run)
+        else:
+            run = []
+    return np.asarray(best, dtype=int)
+
+
+def _mean_angle(degrees: np.ndarray) -> float:
+    """The circular mean of angles in degrees (-180..180)."""
+    r = np.radians(np.asarray(degrees, dtype=float))
+    return float(np.degrees(np.arctan2(np.sin(r).mean(), np.cos(r).mean())))
+
+
 class ForwardModel:
     """P(next state | state, behaviour, object, alpha) from learned predictors and prototypes.
 
@@ -90,6 +118,16 @@ class ForwardModel:
     effects : {"members", "prototype"}
         How a category's effect on an entity is predicted: from the category's members most
         like it (where the model has them), or the category's prototype for all (the thesis).
+    alpha_rule : {"grid", "group", "probability"}
+        Which parameters the planner tries for a behaviour of one parameter (chapter 9):
+        ``grid``, every point of a ``param_steps`` grid; ``group``, thesis 9.5: over an
+        ``alpha_grid``-point grid, the alphas that lead to the same predicted next state
+        (the same most probable category) are grouped, and for each next state the mean
+        of its largest group (a run of neighbouring grid points; circular for an angle) is
+        tried; ``probability`` (our extension): for each predicted next state, the grid
+        point that makes it most probable. Behaviours of several parameters use the grid.
+    alpha_grid : int
+        Grid points the ``group`` and ``probability`` rules search.
 
     A behaviour whose ``target`` is None acts on the whole scene: every visible row changes
     by its own predicted effect, and an outcome is one category per row (its probability
@@ -98,9 +136,14 @@ class ForwardModel:
 
     def __init__(self, behaviors: list[BehaviorModel], schema, min_probability: float = 0.02,
                  param_steps: int = 5, raised: float = 0.05, height: int | None = None,
-                 effects: str = "members"):
+                 effects: str = "members", alpha_rule: str = "grid", alpha_grid: int = 36):
         if effects not in EFFECT_MODELS:
             raise DataError(f"unknown effect model {effects!r}; choose {' or '.join(EFFECT_MODELS)}")
+        if alpha_rule not in ALPHA_RULES:
+            raise DataError(f"unknown alpha rule {alpha_rule!r}; choose {', '.join(ALPHA_RULES)}")
+        self.alpha_rule = alpha_rule
+        self.alpha_grid = int(alpha_grid)
+        self._choices: dict[tuple, list] = {}
         self.behaviors = behaviors
         self.effects = effects
         self.schema = schema
@@ -139,6 +182,74 @@ class ForwardModel:
         axes = [np.linspace(lo, hi, self.param_steps) for lo, hi in ranges]
         return [tuple(float(v) for v in p) for p in product(*axes)]
 
+    def _chooses(self, b: int) -> bool:
+        """Does behaviour ``b`` choose its parameter by a rule rather than try a grid?"""
+        return self.alpha_rule != "grid" and len(self.behaviors[b].parameters) == 1
+
+    def choice_grid(self, b: int) -> np.ndarray:
+        """The ``alpha_grid`` points a rule searches for behaviour ``b``'s one parameter
+        (a full circle's end point left out: it is its start)."""
+        lo, hi = self.behaviors[b].parameters[0]
+        model = self.behaviors[b]
+        circle = bool(model.periodic[0]) if len(model.periodic) else False
+        circle = circle and abs((hi - lo) - 360.0) < 1e-9
+        return np.linspace(lo, hi, self.alpha_grid, endpoint=not circle)
+
+    def choose_alphas(self, f: np.ndarray, b: int, rule: str | None = None) -> list[tuple[tuple[float, ...], int]]:
+        """(alpha, the next state's category) for each next state behaviour ``b`` can bring
+        entity ``f`` to, by ``rule`` (default: the model's ``alpha_rule``; see the class
+        docstring). One batch of predictions over the grid."""
+        rule = rule or self.alpha_rule
+        if rule not in ("group", "probability"):
+            raise DataError(f"choose_alphas needs the group or the probability rule, not {rule!r}")
+        key = (b, f.tobytes(), rule)
+        hit = self._choices.get(key)
+        if hit is not None:
+            return hit
+        model = self.behaviors[b]
+        grid = self.choice_grid(b)
+        alphas = [(float(a),) for a in grid]
+        classes, proba = self._predict_alphas(f, b, alphas)
+        best = np.argmax(proba, axis=1)
+        periodic = bool(model.periodic[0]) if len(model.periodic) else False
+        circle = periodic and abs((model.parameters[0][1] - model.parameters[0][0]) - 360.0) < 1e-9
+        out = []
+        for j in dict.fromkeys(best.tolist()):
+            if rule == "probability":
+                alpha = float(grid[int(np.argmax(proba[:, j]))])
+            else:
+                run = _largest_run(best == j, circle)
+                alpha = _mean_angle(grid[run]) if periodic else float(grid[run].mean())
+            if circle:
+                lo = model.parameters[0][0]
+                alpha = lo + (alpha - lo) % 360.0
+            out.append(((round(alpha, 6),), int(classes[j])))
+        self._choices[key] = out
+        return out
+
+    def alpha_choices(self, f: np.ndarray, b: int) -> list[tuple[float, ...]]:
+        """The parameters the planner tries for behaviour ``b`` on entity ``f``."""
+        if not self._chooses(b):
+            return self.alphas(b)
+        return [a for a, _ in self.choose_alphas(f, b)]
+
+    def _predict_alphas(self, f: np.ndarray, b: int, alphas: list[tuple]) -> tuple[np.ndarray, np.ndarray]:
+        """(categories, P per alpha and category) for entity ``f`` under each of ``alphas``, in
+        one batch; the results are cached as :meth:`distribution` keeps them."""
+        model = self.behaviors[b]
+        cols = [self._alpha_columns(model, a) for a in alphas]
+        X = np.stack([np.concatenate([f[model.selected], a]) for a in cols])
+        proba = self._proba(model.predictor)(X)
+        if model.known is not None:
+            Xk = X if model.known_selected is None else np.stack([np.concatenate([f[model.known_selected], a]) for a in cols])
+            proba = proba * self._proba(model.known)(Xk)[:, list(model.known.classes_).index(1)][:, None]
+        classes = np.asarray(model.predictor.classes_, dtype=int)
+        key = f.tobytes()
+        for a, p in zip(alphas, proba):
+            self._cache[(b, key, a)] = (classes, p)
+        self.predictions += len(alphas)
+        return classes, proba
+
     def distribution(self, f: np.ndarray, b: int, alpha: tuple = ()) -> tuple[np.ndarray, np.ndarray]:
         """(categories, probabilities) of behaviour ``b`` on entity vector ``f``."""
         key = (b, f.tobytes(), alpha)
@@ -159,7 +270,17 @@ class ForwardModel:
     def cached(self, f: np.ndarray) -> bool:
         """Are every behaviour's predictions for entity vector ``f`` at hand?"""
         key = f.tobytes()
-        return all((b, key, a) in self._cache for b in range(len(self.behaviors)) for a in self.alphas(b))
+        for b in range(len(self.behaviors)):
+            if self._chooses(b):
+                chosen = self._choices.get((b, key, self.alpha_rule))
+                if chosen is None:
+                    return False
+                alphas = [a for a, _ in chosen]
+            else:
+                alphas = self.alphas(b)
+            if any((b, key, a) not in self._cache for a in alphas):
+                return False
+        return True
 
     def _alpha_columns(self, model: BehaviorModel, alpha: tuple) -> np.ndarray:
         specs = [{"periodic": bool(model.periodic[j]) if j < len(model.periodic) else False} for j in range(len(alpha))]
@@ -175,6 +296,14 @@ class ForwardModel:
         fresh = {v.tobytes(): v for v in vectors}
         for b, model in enumerate(self.behaviors):
             if only is not None and b != only:
+                continue
+            if self._chooses(b) and alpha_only is None:
+                # each vector's choice of alpha: one batch over the grid per vector, then the
+                # chosen alphas (grid means need their own predictions)
+                for v in fresh.values():
+                    chosen = [a for a in self.alpha_choices(v, b) if (b, v.tobytes(), a) not in self._cache]
+                    if chosen:
+                        self._predict_alphas(v, b, chosen)
                 continue
             for alpha in self.alphas(b) if alpha_only is None else [alpha_only]:
                 todo = [v for key, v in fresh.items() if (b, key, alpha) not in self._cache]

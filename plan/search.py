@@ -194,7 +194,7 @@ def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None, h
         for b, behavior in enumerate(model.behaviors):
             if behavior.target is None:
                 continue
-            for alpha in model.alphas(b):
+            for alpha in model.alpha_choices(state[obj], b):
                 yield b, obj, alpha
 
 

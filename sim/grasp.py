@@ -7,10 +7,11 @@ What the robot has
     camera across the table, facing the robot (thesis 9.3.4).
 
 What the robot perceives (:mod:`features.contact_point`)
-    Each object's 25 contact-point features; ``touch`` is 1 for the object the hand presses
-    on (the detection whose contact point lies nearest the hand's contacts, within 25 cm:
-    the robot knows where on its hand it feels a touch, not what it touches). Objects are
-    tracked across behaviours by their contact points.
+    Each object's 25 contact-point features. Objects are tracked across behaviours by their
+    contact points; then ``touch`` is 1 for the tracked object the hand presses on (the one
+    whose contact point lies nearest the hand's contacts, within 25 cm: the robot knows
+    where on its hand it feels a touch, not what it touches), 0 for the rest and for
+    vanished ones.
 
 What the behaviours do (all aimed at the perceived contact point, CP)
     Every behaviour takes one parameter, the angle alpha in degrees; ``d(alpha)`` is the
@@ -119,15 +120,21 @@ class GraspWorld(TableWorld):
 
     def _features(self, image) -> np.ndarray:
         f, _ = perceive_contact_points(image, self.config.roi(), self.config.hand.shoulder)
-        return self._with_touch(f)
+        return f
+
+    def perceive(self) -> np.ndarray:
+        """Perceive, track, then feel: the touch goes to the tracked object nearest the
+        hand's contacts (fingers may split a held object into two detections; the touch
+        belongs to the one the robot tracks)."""
+        super().perceive()
+        self.known = self._with_touch(self.known)
+        return self.known.copy()
 
     def _positions(self, features: np.ndarray) -> np.ndarray:
         return cp_positions(features)
 
     def _track(self, known: np.ndarray, seen: np.ndarray) -> np.ndarray:
-        out = match(known, seen, cp_positions(known), cp_positions(seen), 0.35, _VISIBLE)
-        out[out[:, _VISIBLE] < 0.5, _TOUCH] = 0.0  # a vanished object is touched by nothing the robot sees
-        return out
+        return match(known, seen, cp_positions(known), cp_positions(seen), 0.35, _VISIBLE)
 
     def outcomes(self, before: list[ObjectTruth], after: list[ObjectTruth], perceived: np.ndarray) -> list[int]:
         top = self.config.table_top

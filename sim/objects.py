@@ -17,7 +17,7 @@ import open3d as o3d
 import sapien
 from afford.features.errors import DataError
 
-__all__ = ["SHAPES", "SOLID_SHAPES", "HANDLE", "ObjectSpec", "box_mesh", "build_object", "object_mesh",
+__all__ = ["SHAPES", "SOLID_SHAPES", "HANDLE", "MUG_MIN_HEIGHT", "ObjectSpec", "box_mesh", "build_object", "object_mesh",
            "yaw_quaternion", "handle_boxes"]
 
 #: The object shapes the scenes know, in the order ground truth stores them.
@@ -29,6 +29,8 @@ SOLID_SHAPES = SHAPES[:4]
 #: fixed"): how far it stands out from the wall, its height, the thickness of its bars and
 #: its width, metres. Its opening is 3.3 cm deep and 4.6 cm high, room for one finger.
 HANDLE = {"reach": 0.045, "height": 0.07, "bar": 0.012, "width": 0.02}
+#: A mug is at least this tall, so that its handle fits on its side.
+MUG_MIN_HEIGHT = 0.09
 
 # Rotation of a cylinder's local frame so that its axis (x) points up (z).
 _UPRIGHT = np.array([math.cos(-math.pi / 4), 0.0, math.sin(-math.pi / 4), 0.0])
@@ -84,8 +86,8 @@ class ObjectSpec:
             raise DataError(f"a {self.shape} needs {want} size value(s), got {len(self.size)}")
         if any(not (0.01 <= s <= 1.0) for s in self.size):
             raise DataError(f"object sizes must be between 0.01 and 1.0 m, got {list(self.size)}")
-        if self.shape == "mug" and self.size[1] < HANDLE["height"] + 0.02:
-            raise DataError(f"a mug must be at least {HANDLE['height'] + 0.02:.2f} m tall to carry its handle, "
+        if self.shape == "mug" and self.size[1] < MUG_MIN_HEIGHT - 1e-9:
+            raise DataError(f"a mug must be at least {MUG_MIN_HEIGHT:.2f} m tall to carry its handle, "
                             f"got {self.size[1]}")
         if len(self.position) != 2:
             raise DataError("an object's position is [x, y] on the table")

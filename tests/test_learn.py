@@ -309,10 +309,22 @@ def test_predictor_copes_with_tiny_categories():
     assert (model.predict(X[3:]) == y[3:]).mean() > 0.9
 
 
+def test_a_behaviour_that_always_had_one_effect_is_certain_of_it():
+    """Chapter 9's open-hand on an empty table: nothing ever happens, and the robot learns so."""
+    X = np.random.default_rng(0).normal(size=(50, 4))
+    model = AffordancePredictor().fit(X, np.full(50, 3))
+    assert model.classes_.tolist() == [3] and model.cv_report_["constant"]
+    Xt = np.random.default_rng(1).normal(size=(7, 4)) * 10
+    assert np.array_equal(model.predict_proba(Xt), np.ones((7, 1))) and model.predict(Xt).tolist() == [3] * 7
+    from afford.learn.predictors import fast_predict_proba
+
+    assert np.array_equal(fast_predict_proba(model)(Xt), np.ones((7, 1)))
+    fr = FeatureRelevance().fit(X, np.zeros(50))
+    assert fr.selected_.size == 0 and np.all(fr.scores_ == 0)
+
+
 def test_predictor_refuses_bad_input():
     X = np.random.default_rng(0).normal(size=(50, 4))
-    with pytest.raises(ValueError, match="one class"):
-        AffordancePredictor().fit(X, np.ones(50))
     bad = X.copy()
     bad[7, 2] = np.nan
     with pytest.raises(ValueError, match="NaN"):

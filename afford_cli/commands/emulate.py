@@ -11,7 +11,7 @@ from afford.commands.plan import render_plan
 from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
-from afford.options import EffectModel, Effects, Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
+from afford.options import AlphaRule, AlphaRuleOpt, EffectModel, Effects, Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
 from afford.scenes_io import open_world, scene_layout
@@ -30,6 +30,7 @@ def emulate(
     alternatives: Alternatives = 3,
     plot: PlotFile = None,
     effects: Effects = EffectModel.members,
+    alpha_rule: AlphaRuleOpt = AlphaRule.group,
     json: Json = False,
 ) -> None:
     """Emulate a shown goal scene (thesis 8.6-8.7): derive constraints, plan, execute, monitor."""
@@ -38,6 +39,7 @@ def emulate(
     check_plot_file(plot)
     loaded = load_model(model)
     loaded.effect_model = effects.value
+    loaded.alpha_rule = alpha_rule.value
     loaded.check_effects("emulation")
     sc, shown = scene_layout(scene, None, observe, allow_empty=True)
     _, specs = scene_layout(scene, None, start)

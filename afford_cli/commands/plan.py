@@ -13,7 +13,7 @@ from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
 from afford.options import (
-    EffectModel, Effects,
+    AlphaRule, AlphaRuleOpt, EffectModel, Effects,
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
 )
 from afford.output import Output
@@ -91,6 +91,7 @@ def plan(
     alternatives: Alternatives = 3,
     plot: PlotFile = None,
     effects: Effects = EffectModel.members,
+    alpha_rule: AlphaRuleOpt = AlphaRule.group,
     json: Json = False,
 ) -> None:
     """Plan a behaviour sequence in the robot's own perceptual space to reach a goal."""
@@ -101,6 +102,7 @@ def plan(
     check_plot_file(plot)
     loaded = load_model(model)
     loaded.effect_model = effects.value
+    loaded.alpha_rule = alpha_rule.value
     loaded.check_effects("planning")
     g = parse_goal(goal, loaded.schema)
     limits = {"max_depth": max_depth, "max_nodes": max_nodes}

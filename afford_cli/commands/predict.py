@@ -16,7 +16,7 @@ from rich import box
 from rich.table import Table
 
 from afford.learning import load_model
-from afford.options import EffectModel, Effects, Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
+from afford.options import AlphaRule, AlphaRuleOpt, EffectModel, Effects, Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
 from afford.scenes_io import open_world, scene_layout
@@ -104,6 +104,7 @@ def predict(
     want: Annotated[Optional[list[str]], typer.Option("--want", help="Inverse query: rank (object, behaviour, alpha) by the probability that one step makes OBJ:FEATURE=VALUE~RANGE hold.")] = None,
     plot: PlotFile = None,
     effects: Effects = EffectModel.members,
+    alpha_rule: AlphaRuleOpt = AlphaRule.group,
     json: Json = False,
 ) -> None:
     """Predict, for every entity the robot sees, what each behaviour would do."""
@@ -111,6 +112,7 @@ def predict(
     check_plot_file(plot)
     loaded = load_model(model)
     loaded.effect_model = effects.value
+    loaded.alpha_rule = alpha_rule.value
     if want:
         loaded.check_effects("an inverse query (--want)")
     sc, specs = scene_layout(scene, seed, layout, objects=objects)

@@ -44,7 +44,9 @@ def select_features(
         table.add_column("n", justify="right")
         table.add_column("features, most relevant first")
         for name, r in result["behaviors"].items():
-            table.add_row(name, str(len(r["selected"])), ", ".join(r["selected"]))
+            # a parameter was a candidate too; it goes into the predictor in any case
+            ranks = [f"{p} ranked {v['rank']}" for p, v in r.get("parameters", {}).items()]
+            table.add_row(name, str(len(r["selected"])), ", ".join(r["selected"]) + (f" ({'; '.join(ranks)})" if ranks else ""))
         console.print(table)
         console.print(f"-> {output} ({result['seconds']:.1f} s)")
 

@@ -36,7 +36,7 @@ import numpy as np
 from afford.features.contact_point import contact_point_schema
 from afford.features.errors import DataError
 from afford.sim.grasp import GRASP_BEHAVIORS, GRASP_OUTCOMES, GraspConfig, GraspWorld
-from afford.sim.objects import HANDLE, ObjectSpec
+from afford.sim.objects import MUG_MIN_HEIGHT, ObjectSpec
 from afford.sim.registry import register_scene
 from afford.sim.scenes.table import TableScene, TableSceneConfig
 
@@ -75,7 +75,7 @@ class GraspScene(TableScene):
         n = {"box": 3, "cylinder": 2, "sphere": 1, "mug": 2}[shape]
         size = [float(round(v, 4)) for v in rng.uniform(lo, hi, size=n)]
         if shape == "mug":
-            size[1] = max(size[1], round(HANDLE["height"] + 0.02, 4))
+            size[1] = max(size[1], MUG_MIN_HEIGHT)
         yaw = float(rng.uniform(0.0, 360.0))
         hx, hy = ObjectSpec(shape, tuple(size), (0.0, 0.0), yaw).half_footprint
         w = c.world
