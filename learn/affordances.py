@@ -150,6 +150,11 @@ def _split_parameters(fr: FeatureRelevance, d: int, params: list[dict]) -> Featu
     fr.parameter_scores_ = {}
     if not params:
         return fr
+    if not np.any(fr.scores_):  # one effect only: nothing was ranked, the parameters neither
+        fr.selected_ = np.asarray([i for i in fr.selected_ if i < d], dtype=int)
+        fr.ranking_ = np.arange(d)
+        fr.scores_ = np.asarray(fr.scores_[:d])
+        return fr
     units = _parameter_units(params, 0)
     order = [int(i) for i in fr.ranking_]
     for j, p in enumerate(params):

@@ -90,15 +90,36 @@ class HandConfig:
         return self.palm_half[0] + self.finger_half[0]
 
 
-class Hand:
-    """The hand in one SAPIEN scene; ``world`` steps physics while the hand moves."""
+class GantryHand:
+    """What every hand on the gantry shares: how it is begun, and its reach (a disc of
+    ``config.reach`` about ``config.shoulder``, palm targets pulled into one ``palm_slack``
+    wider)."""
 
-    def __init__(self, scene: sapien.Scene, config: HandConfig = HandConfig()):
+    def _begin(self, scene: sapien.Scene, config, density: float):
+        """(material, articulation builder, palm link builder with its box) of a new hand."""
         self.config = c = config
         material = sapien.physx.PhysxMaterial(c.friction, c.friction, 0.0)
         ab = scene.create_articulation_builder()
         palm = build_gantry(ab)
-        palm.add_box_collision(half_size=c.palm_half, material=material, density=500)
+        palm.add_box_collision(half_size=c.palm_half, material=material, density=density)
+        return material, ab, palm
+
+    def clamp_to_reach(self, target: np.ndarray) -> np.ndarray:
+        """Pull a palm target back into the reachable disc."""
+        c = self.config
+        return clamp_to_disc(target, c.shoulder, c.reach + c.palm_slack)
+
+    def reaches(self, target: np.ndarray) -> bool:
+        d = np.asarray(target[:2], dtype=float) - np.asarray(self.config.shoulder)
+        return bool(np.hypot(*d) <= self.config.reach + 1e-9)
+
+
+class Hand(GantryHand):
+    """The hand in one SAPIEN scene; ``world`` steps physics while the hand moves."""
+
+    def __init__(self, scene: sapien.Scene, config: HandConfig = HandConfig()):
+        c = config
+        material, ab, palm = self._begin(scene, config, density=500)
         fingers = []
         for name, q in (("finger-left", _Q_Y), ("finger-right", _Q_NEG_Y)):
             f = ab.create_link_builder(palm)
@@ -142,15 +163,6 @@ class Hand:
     @property
     def finger_opening(self) -> float:
         return float(np.mean(self.articulation.get_qpos()[4:]))
-
-    def clamp_to_reach(self, target: np.ndarray) -> np.ndarray:
-        """Pull a palm target back into the reachable disc."""
-        c = self.config
-        return clamp_to_disc(target, c.shoulder, c.reach + c.palm_slack)
-
-    def reaches(self, target: np.ndarray) -> bool:
-        d = np.asarray(target[:2], dtype=float) - np.asarray(self.config.shoulder)
-        return bool(np.hypot(*d) <= self.config.reach + 1e-9)
 
     # -- commands (no stepping here: the world steps) -------------------------------------
     def teleport(self, position: np.ndarray, yaw: float, fingers: float) -> None:

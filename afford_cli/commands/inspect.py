@@ -137,8 +137,11 @@ def render(console, info: dict) -> None:
                 extra.append(f"relevant features: {', '.join(report['selected'])}")
             if report.get("cv"):
                 cv = report["cv"]
-                extra.append(f"cross-validated accuracy {100 * cv['cv_accuracy']:.1f}% "
-                             f"(C={cv['best_params'].get('C')}, gamma={cv['best_params'].get('gamma', '-')})")
+                if cv.get("constant"):
+                    extra.append("one effect only: predicted with certainty")
+                else:
+                    extra.append(f"cross-validated accuracy {100 * cv['cv_accuracy']:.1f}% "
+                                 f"(C={cv['best_params'].get('C')}, gamma={cv['best_params'].get('gamma', '-')})")
             if report.get("member_effects"):
                 me = report["member_effects"]
                 k = me.get("k") if isinstance(me.get("k"), dict) else {}

@@ -35,7 +35,8 @@ def train(
             table.add_column(col, no_wrap=True)
         for name, b in result["behaviors"].items():
             p = b["best_params"]
-            table.add_row(name, str(b["n_categories"]), str(b["n_features"]), f"{p.get('C')}",
+            # a behaviour with one effect has no machine: it is certain of that effect
+            table.add_row(name, str(b["n_categories"]), str(b["n_features"]), f"{p['C']}" if "C" in p else "-",
                           f"{p.get('gamma', '-'):.3g}" if "gamma" in p else "-", f"{100 * b['cv_accuracy']:.1f}%")
         console.print(table)
         console.print(f"-> {output} ({result['seconds']:.1f} s)")

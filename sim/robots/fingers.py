@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import sapien
 
-from afford.sim.hand import _Q_Z, build_gantry, clamp_to_disc
+from afford.sim.hand import _Q_Z, GantryHand
 
 __all__ = ["FingerHandConfig", "FingerHand", "FINGERS", "PRECISION"]
 
@@ -91,15 +91,12 @@ class FingerHandConfig:
         return self.palm_half[0] + self.phalanx[0] * math.cos(a) + self.phalanx[1] * math.cos(a + b)
 
 
-class FingerHand:
+class FingerHand(GantryHand):
     """The hand in one SAPIEN scene; the world steps physics while the hand moves."""
 
     def __init__(self, scene: sapien.Scene, config: FingerHandConfig = FingerHandConfig()):
-        self.config = c = config
-        material = sapien.physx.PhysxMaterial(c.friction, c.friction, 0.0)
-        ab = scene.create_articulation_builder()
-        palm = build_gantry(ab)
-        palm.add_box_collision(half_size=c.palm_half, material=material, density=400)
+        c = config
+        material, ab, palm = self._begin(scene, config, density=400)
         heights = c.heights()
         self._sign = {}
         for name in FINGERS:
@@ -172,14 +169,6 @@ class FingerHand:
         link = self.links[f"{name}-1"]
         pose = link.entity_pose
         return np.asarray(pose.to_transformation_matrix() @ np.array([self.config.phalanx[1], 0, 0, 1.0]))[:3]
-
-    def clamp_to_reach(self, target: np.ndarray) -> np.ndarray:
-        c = self.config
-        return clamp_to_disc(target, c.shoulder, c.reach + c.palm_slack)
-
-    def reaches(self, target: np.ndarray) -> bool:
-        d = np.asarray(target[:2], dtype=float) - np.asarray(self.config.shoulder)
-        return bool(np.hypot(*d) <= self.config.reach + 1e-9)
 
     # -- commands (no stepping here: the world steps) -------------------------------------
     def _finger_q(self, openings: dict[str, float], grip: str = "fist") -> dict[str, float]:
