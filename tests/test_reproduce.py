@@ -67,3 +67,24 @@ def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     assert doc["thesis"]["table_7_1"]["2"][1] == [538, 605]
     assert "Table 7.1" in (tmp_path / "table_7_1_crane.md").read_text()
     assert (tmp_path / "table_7_1_crane.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_grasp_tables_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
+    script = SCRIPTS / "tables_9_1_9_2_grasp.py"
+    subprocess.run([sys.executable, str(script), "--quick", "--train", "500", "--test", "200", "--workers", "2",
+                    "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "tables_9_1_9_2_grasp.json").read_text())
+    assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
+    rows = doc["rows"]
+    assert {r["figure"] for r in rows} >= {"9.1", "9.2", "accuracy", "9.8"}
+    acc = {r["behavior"]: r for r in rows if r["figure"] == "accuracy"}
+    assert set(acc) == {"open-hand", "move-hand", "push-object", "power-grasp", "precision-grasp"}
+    assert acc["power-grasp"]["thesis"] == 0.72 and acc["push-object"]["thesis"] == 0.92
+    assert all(0.0 <= r["accuracy"] <= 1.0 for r in acc.values())
+    cells = [r for r in rows if r["figure"] == "9.8"]
+    assert len(cells) == 7 * 6  # yaw -90..90 by 30, alpha -70..30 by 20
+    # the box is lifted from some sides and angles and not from others (PhysX's doing)
+    assert 0 < sum(r["lifted"] for r in cells) < len(cells)
+    assert 0.0 <= doc["summary"]["map_agreement"] <= 1.0
+    assert "Table 9.1" in (tmp_path / "tables_9_1_9_2_grasp.md").read_text()
+    assert (tmp_path / "tables_9_1_9_2_grasp.png").read_bytes()[:4] == b"\x89PNG"
