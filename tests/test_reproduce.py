@@ -50,8 +50,8 @@ def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_pat
 
 def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     script = SCRIPTS / "table_7_1_crane.py"
-    subprocess.run([sys.executable, str(script), "--quick", "--train", "150", "--test", "50", "--placements", "25",
-                    "--layouts", "2", "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    subprocess.run([sys.executable, str(script), "--quick", "--train", "150", "--test", "50", "--placements", "15",
+                    "--layouts", "1", "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
     doc = json.loads((tmp_path / "table_7_1_crane.json").read_text())
     assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
     figures = {r["figure"] for r in doc["rows"]}
@@ -71,7 +71,7 @@ def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
 
 def test_grasp_tables_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     script = SCRIPTS / "tables_9_1_9_2_grasp.py"
-    subprocess.run([sys.executable, str(script), "--quick", "--train", "500", "--test", "200", "--workers", "2",
+    subprocess.run([sys.executable, str(script), "--quick", "--train", "400", "--test", "160", "--workers", "2",
                     "--out", str(tmp_path)], check=True, capture_output=True)
     doc = json.loads((tmp_path / "tables_9_1_9_2_grasp.json").read_text())
     assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
