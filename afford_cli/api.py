@@ -95,7 +95,7 @@ def save(data, path: str, *, seed: int | None = None, episodes: tuple[int, int] 
 # -- learning: one artefact in, the next out (what cluster | select-features | train do) ------
 
 def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5, k: int | dict | None = None,
-            prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
+            prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0, channels: list[str] | None = None,
             progress: Callable[[int, int], None] | None = None) -> dict:
     """Discover effect categories per behaviour (thesis 8.4.1, Algorithm 7): reads an
     ``interactions`` artefact, writes ``effects``; returns the summary ``afford cluster
@@ -104,7 +104,10 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5
     ``method`` None: the scene's own (``clustering`` in its description: chapter 7's
     crane clusters with k-means, lift into 2), else the hierarchical method. ``k``: one
     k for every behaviour or ``{behaviour: k, "*": k}``; given with the scene's method,
-    it overrides the scene's k behaviour by behaviour."""
+    it overrides the scene's k behaviour by behaviour. ``channels``: the effect channels
+    categories are formed by (hierarchical); None: the scene's own (chapter 9's grasp:
+    visibility, contact point and touch, as tables 9.1-9.2), else every channel.
+    The scene's defaults are the thesis's; any option given here overrides them."""
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
@@ -116,17 +119,29 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5
     if not data.has_after:
         raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
                           f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
+    own = data.scene.get("clustering") or {}
     if method is None:  # the scene's own clustering; a k given here overrides its k
-        own = data.scene.get("clustering") or {}
         method = own.get("method", "hierarchical")
         if own.get("k"):
             k = {**own["k"], **({} if k is None else k if isinstance(k, dict) else {"*": k})}
+    if channels is None and method == "hierarchical":
+        channels = own.get("channels")
+    if channels is not None:
+        channels = [str(c) for c in channels]
+        known = list(dict.fromkeys(data.schema.channels))
+        unknown = [c for c in channels if c not in known]
+        if unknown or not channels:
+            raise AffordError(f"no effect channel {', '.join(map(repr, unknown)) or 'given'} in {art.source}; "
+                              f"its channels are {', '.join(known)}")
+        if method != "hierarchical":
+            raise AffordError("--channels goes with the hierarchical method (k-means clusters every channel at once)")
     if k is not None and method != "kmeans":
         raise AffordError("a k goes with the k-means method (--method kmeans)")
     start = time.perf_counter()
     models, labels = discover_effects(data, method=method, k_max=k_max, k=k, prune=prune, min_fraction=min_fraction,
-                                      seed=seed, progress=_per_behaviour(progress, data))
-    settings = {"method": method, "k_max": k_max, "k": k, "prune": prune, "min_fraction": min_fraction}
+                                      seed=seed, channels=channels, progress=_per_behaviour(progress, data))
+    settings = {"method": method, "k_max": k_max, "k": k, "prune": prune, "min_fraction": min_fraction,
+                "channels": channels}
     arrays, meta, blobs = effects_members(data, labels, models, settings)
     write_artifact(output, artifact_bytes("effects", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     return {"output": output, "seconds": round(time.perf_counter() - start, 3),

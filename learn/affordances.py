@@ -79,8 +79,11 @@ def k_per_behaviour(k: int | dict | None, names: list[str]) -> dict[str, int | N
 def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max: int = 5,
                      k: int | dict[str, int] | None = None,
                      prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
+                     channels: list[str] | None = None,
                      progress: Callable[[int], None] | None = None) -> tuple[dict, np.ndarray]:
     """Effect categories per behaviour; returns ``({name: EffectCategories}, labels)``.
+
+    ``channels``: the effect channels categories are formed by (hierarchical; None: all).
 
     ``k`` (k-means only): one number for every behaviour, or ``{behaviour: k}`` with ``"*"``
     for the others (chapter 7 used 2 for lift and varied the moves').
@@ -97,7 +100,8 @@ def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max:
         _check_rows(data, b, rows, "clustering")
         X = predictor_inputs(data.before_rows(rows), data.params[rows], np.arange(len(data.schema)), parameters_of(data, b))
         ec = EffectCategories(schema=tuple(data.schema.channels), method=method, k_max=k_max, k=ks[name], prune=prune,
-                              min_fraction=min_fraction, random_state=behaviour_seed(seed, b))
+                              min_fraction=min_fraction, channels=None if channels is None else tuple(channels),
+                              random_state=behaviour_seed(seed, b))
         ec.fit(effects[rows], X)
         labels[rows] = ec.labels_
         models[name] = ec

@@ -128,6 +128,13 @@ class EffectCategories(BaseEstimator):
         needs). ``"auto"``: ``"channel"`` for hierarchical, ``"feature"`` for k-means. X-means
         within a channel does not depend on the channel's overall scale, so ``"channel"``
         only matters for prediction distances, where it gives every channel the same weight.
+    channels : sequence of str or None, default=None
+        The channels whose changes form categories (``"hierarchical"`` only); None: every
+        channel of ``schema``. The others still shape each category's prototype (its
+        members' mean effect over every column). Chapter 9's tables 9.1 and 9.2 have
+        categories of visibility, position and touch only: there the contact point's
+        neighbourhood (borders, patches, normals) changes with any move, and X-means
+        splits the rare lifts by it into products too small to keep.
     random_state : int, RandomState instance or None, default=None
 
     Attributes
@@ -188,6 +195,7 @@ class EffectCategories(BaseEstimator):
         "n_opt": [Interval(numbers.Integral, 1, None, closed="left")],
         "cv": [Interval(numbers.Integral, 2, None, closed="left")],
         "scaling": [StrOptions({"auto", "channel", "feature"})],
+        "channels": ["array-like", None],
         "random_state": ["random_state"],
     }
 
@@ -204,6 +212,7 @@ class EffectCategories(BaseEstimator):
         n_opt=1,
         cv=3,
         scaling="auto",
+        channels=None,
         random_state=None,
     ):
         self.schema = schema
@@ -217,6 +226,7 @@ class EffectCategories(BaseEstimator):
         self.n_opt = n_opt
         self.cv = cv
         self.scaling = scaling
+        self.channels = channels
         self.random_state = random_state
 
     # ------------------------------------------------------------------ fitting
@@ -257,6 +267,14 @@ class EffectCategories(BaseEstimator):
 
         if self.method == "hierarchical":
             groups = _channels_of(self.schema, d)
+            if self.channels is not None:
+                wanted = [str(c) for c in self.channels]
+                known = [name for name, _ in groups]
+                unknown = [c for c in wanted if c not in known]
+                if unknown or not wanted:
+                    raise DataError(f"no channel {', '.join(map(repr, unknown)) or 'given'} to form categories by; "
+                                    f"the effects' channels are {', '.join(known)}")
+                groups = [(name, cols) for name, cols in groups if name in wanted]
         else:
             if self.schema is not None:
                 _channels_of(self.schema, d)

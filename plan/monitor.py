@@ -24,7 +24,7 @@ from typing import Callable, Protocol
 
 import numpy as np
 
-from afford.plan.forward import ForwardModel
+from afford.plan.forward import ForwardModel, one_blas_thread
 from afford.plan.forward import SCENE
 from afford.plan.goals import Goal
 from afford.plan.search import UNREACHABLE, Plan, best_plans, search, situation
@@ -96,6 +96,7 @@ def mismatch(goal: Goal, predicted: np.ndarray, perceived: np.ndarray, schema, s
     return ""
 
 
+@one_blas_thread
 def execute(world: World, model: ForwardModel, goal: Goal, *, method: str = "best-first", max_replans: int = 3,
             first: Plan | None = None, planner: Callable[[np.ndarray, tuple, int], Plan] | None = None,
             say: Callable[[str], None] | None = None, **limits) -> Execution:
@@ -249,6 +250,7 @@ def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: 
                   imagined_nodes=imagined_nodes, budget=budget, **limits)[0]
 
 
+@one_blas_thread
 def _reach(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int, method: str,
            rollouts: int, seed: int, imagined_nodes: int, budget: int, **limits) -> tuple[float, int]:
     """:func:`reach_probability` and the number of rollouts it ran."""

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from afford.plan.forward import SCENE, ForwardModel
+from afford.plan.forward import SCENE, ForwardModel, one_blas_thread
 from afford.plan.goals import Goal
 
 __all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE", "UNREACHABLE"]
@@ -213,6 +213,7 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
                       heuristic_weight=heuristic_weight, avoid=avoid, held=held)[0]
 
 
+@one_blas_thread
 def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int, *, max_depth: int = 4,
                max_nodes: int = 20000, heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1) -> list[Plan]:
     """The ``n_plans`` most probable plans with different behaviour sequences, best first.
@@ -296,6 +297,7 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
                           f"no plan of at most {max_depth} steps reaches the goal", tree)]
 
 
+@one_blas_thread
 def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4,
                   max_nodes: int = 20000, avoid: tuple = (), held: int = -1) -> Plan:
     """Forward chaining over each behaviour's most probable outcome (thesis chapter 7)."""

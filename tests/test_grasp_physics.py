@@ -63,6 +63,13 @@ def test_a_ball_is_caught_in_a_power_grasp():
     assert outcome == "lifted"
 
 
+@pytest.mark.parametrize("alpha", [-30.0, 30.0])
+def test_a_ball_is_pinched_between_thumb_and_index_and_lifted(alpha):
+    outcome, before, after = _act(ObjectSpec("sphere", (0.11,), (0.70, 0.0)), "precision-grasp", alpha)
+    assert outcome == "lifted"
+    assert after[S.index("touch")] == 1.0 and after[S.index("cp_z")] - before[S.index("cp_z")] > 0.15
+
+
 def test_a_mug_is_pinched_and_lifted_with_its_handle_towards_the_robot():
     outcome, before, after = _act(ObjectSpec("mug", (0.09, 0.12), (0.70, 0.0), 180.0), "precision-grasp", 0.0)
     assert outcome == "lifted"

@@ -14,6 +14,7 @@ from sklearn.metrics import adjusted_rand_score
 from sklearn.utils.estimator_checks import check_estimator
 
 from afford.features import FeatureSchema
+from afford.features.errors import DataError
 from afford.learn import (
     TRUSTED_TYPES,
     AffordancePredictor,
@@ -124,6 +125,19 @@ def test_hierarchical_recovers_channels_and_product():
     # channel names as a plain tuple work the same
     ec2 = EffectCategories(schema=SCHEMA.channels, random_state=0).fit(E)
     assert np.array_equal(ec2.labels_, ec.labels_)
+
+
+def test_categories_formed_by_some_channels_ignore_the_others_yet_prototypes_span_all():
+    E, vis, pos, shp, _ = planted_effects()
+    ec = EffectCategories(schema=SCHEMA, channels=("visibility", "position"), random_state=0).fit(E)
+    assert ec.channels_ == ["visibility", "position"]
+    assert ec.n_categories_ == 6  # the shape channel's two clusters no longer split them
+    assert adjusted_rand_score(vis * 3 + pos, ec.labels_) == 1.0
+    for c in range(ec.n_categories_):
+        assert np.allclose(ec.prototypes_[c], E[ec.labels_ == c].mean(axis=0))  # shape columns included
+    assert np.array_equal(ec.predict(E), ec.labels_) and np.array_equal(ec.assign(E), ec.labels_)
+    with pytest.raises(DataError, match="no channel 'colour'"):
+        EffectCategories(schema=SCHEMA, channels=("visibility", "colour")).fit(E)
 
 
 def test_frequency_pruning_drops_rare_category_with_members():

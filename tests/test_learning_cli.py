@@ -247,3 +247,18 @@ def test_a_scene_the_model_cannot_perceive_is_refused_once_not_skipped(pipeline)
     result = runner.invoke(app, ["plan", str(pipeline / "model.afford"), "--scene", "traverse-gaps", "--seed", "1",
                                  "--episodes", "2", "--goal", "*:visibility=0"])
     assert result.exit_code == 1 and "another feature schema" in result.output
+
+
+def test_cluster_forms_categories_by_the_channels_asked_and_refuses_unknown_ones(pipeline, tmp_path):
+    from tests.clitools import fails
+
+    out = json.loads(ok(["cluster", str(pipeline / "train.afford"), "-o", str(tmp_path / "e.afford"),
+                         "--channels", "visibility", "--json"]).stdout)
+    lift = out["behaviors"]["lift"]["categories"]
+    assert len(lift) == 2, "in view or vanished: nothing else tells effects apart"
+    assert sorted(round(c["prototype"]["visibility"]) for c in lift) == [-1, 0]
+    assert any(abs(c["prototype"]["z_min"]) > 0.01 for c in lift), "prototypes still span every channel"
+    msg = fails(["cluster", str(pipeline / "train.afford"), "-o", str(tmp_path / "x.afford"), "--channels", "visibility,colour"])
+    assert msg.strip().splitlines() == [f"error: no effect channel 'colour' in {pipeline / 'train.afford'}; "
+                                        "its channels are visibility, position, shape"]
+    assert not (tmp_path / "x.afford").exists()

@@ -449,3 +449,17 @@ def test_a_behaviour_without_a_target_moves_every_seen_object_by_its_own_outcome
     assert abs(plan.path_probability - 0.64 ** 2) < 1e-9
     assert abs(success_probability(fm, start, goal("0:x_min=0.4~0.02", "1:x_min=1.4~0.02"), plan.steps)
                - 0.64 ** 2) < 1e-9
+
+
+def test_planning_runs_blas_on_one_thread_and_gives_the_threads_back():
+    from threadpoolctl import threadpool_info
+
+    from afford.plan.forward import one_blas_thread
+
+    def blas_threads():
+        return {i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}
+
+    before = blas_threads()
+    seen = one_blas_thread(blas_threads)()
+    assert seen == {1}
+    assert blas_threads() == before

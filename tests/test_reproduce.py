@@ -72,8 +72,16 @@ def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
 def test_grasp_tables_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     script = SCRIPTS / "tables_9_1_9_2_grasp.py"
     subprocess.run([sys.executable, str(script), "--quick", "--train", "400", "--test", "160", "--workers", "2",
-                    "--out", str(tmp_path)], check=True, capture_output=True)
+                    "--plans", "1", "--out", str(tmp_path)], check=True, capture_output=True)
     doc = json.loads((tmp_path / "tables_9_1_9_2_grasp.json").read_text())
+    # criterion 4: one scene some grasp lifts, planned with both alpha rules, each plan run
+    plans = {r["rule"]: r for r in doc["rows"] if r["figure"] == "plans"}
+    assert set(plans) == {"group", "probability"} and all(r["scenes"] == 1 for r in plans.values())
+    assert len({r["seed"] for r in doc["plans"]}) == 1 and {r["rule"] for r in doc["plans"]} == set(plans)
+    for r in doc["plans"]:
+        assert isinstance(r["reached"], bool) and 0.0 <= r["p"] <= 1.0
+        assert not r["found"] or r["steps"][0]["behavior"] in ("power-grasp", "precision-grasp", "push-object",
+                                                                "move-hand", "open-hand")
     assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
     rows = doc["rows"]
     assert {r["figure"] for r in rows} >= {"9.1", "9.2", "accuracy", "9.8"}

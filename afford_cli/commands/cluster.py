@@ -47,6 +47,7 @@ def cluster(
     k: Annotated[Optional[list[str]], typer.Option("--k", help="Clusters of k-means: K for every behaviour, or BEHAVIOUR=K for one (repeat the option).")] = None,
     prune: Annotated[Prune, typer.Option(help="Drop rare categories (chapter 8) or unpredictable ones (Algorithm 7).")] = Prune.frequency,
     min_fraction: Annotated[float, typer.Option("--min-fraction", min=0.0, max=0.5, help="Frequency pruning: smallest share a category must hold.")] = 0.03,
+    channels: Annotated[Optional[str], typer.Option("--channels", help="Comma-separated effect channels that form categories (hierarchical); the others still shape the prototypes. Default: the scene's own (grasp: visibility,cp,touch, as tables 9.1-9.2), else all.")] = None,
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
@@ -60,7 +61,8 @@ def cluster(
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress("clustering effects (behaviours)", None, lazy=True) as update:
         result = run(path, output, method=None if method is None else method.value, k_max=kmax, k=ks, prune=prune.value,
-                     min_fraction=min_fraction, seed=seed, progress=update)
+                     min_fraction=min_fraction, seed=seed, progress=update,
+                     channels=None if channels is None else [c.strip() for c in channels.split(",") if c.strip()])
 
     def render(console):
         from afford.reports import render_categories

@@ -60,6 +60,10 @@ class GraspScene(TableScene):
     behaviors = GRASP_BEHAVIORS
     summary = "a three-finger hand pushes, power- and precision-grasps objects from an approach angle (thesis chapter 9)"
     outcomes = GRASP_OUTCOMES
+    #: ``afford cluster``'s defaults: categories of visibility, contact point and touch, the
+    #: channels of tables 9.1 and 9.2 (the shape channels change with any move of the contact
+    #: point, and split the rare lifts into products too small to keep).
+    clustering = {"channels": ["visibility", "cp", "touch"]}
 
     def __init__(self, config: GraspSceneConfig | None = None):
         super().__init__(config or GraspSceneConfig())
@@ -82,6 +86,11 @@ class GraspScene(TableScene):
         x = float(rng.uniform(w.table_near + hx, max(w.table_near + hx, w.table_far - hx)))
         y = float(rng.uniform(-w.table_width / 2 + hy, max(-w.table_width / 2 + hy, w.table_width / 2 - hy)))
         return ObjectSpec(shape, tuple(size), (round(x, 4), round(y, 4)), round(yaw, 3))
+
+    def describe(self) -> dict:
+        d = super().describe()
+        d["clustering"] = {"channels": list(self.clustering["channels"])}
+        return d
 
     def check_layout(self, objects: list[ObjectSpec]) -> None:
         if any(o.held for o in objects):
