@@ -94,7 +94,7 @@ def save(data, path: str, *, seed: int | None = None, episodes: tuple[int, int] 
 
 # -- learning: one artefact in, the next out (what cluster | select-features | train do) ------
 
-def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5, k: int | dict | None = None,
+def cluster(path: str, output: str, *, method: str | None = None, k_max: int | None = None, k: int | dict | None = None,
             prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0, channels: list[str] | None = None,
             progress: Callable[[int, int], None] | None = None) -> dict:
     """Discover effect categories per behaviour (thesis 8.4.1, Algorithm 7): reads an
@@ -106,7 +106,8 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5
     k for every behaviour or ``{behaviour: k, "*": k}``; given with the scene's method,
     it overrides the scene's k behaviour by behaviour. ``channels``: the effect channels
     categories are formed by (hierarchical); None: the scene's own (chapter 9's grasp:
-    visibility, contact point and touch, as tables 9.1-9.2), else every channel.
+    visibility, contact point and touch, as tables 9.1-9.2), else every channel. ``k_max``
+    None: the scene's own (grasp: 4), else 5.
     The scene's defaults are the thesis's; any option given here overrides them."""
     import time
 
@@ -126,6 +127,8 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int = 5
             k = {**own["k"], **({} if k is None else k if isinstance(k, dict) else {"*": k})}
     if channels is None and method == "hierarchical":
         channels = own.get("channels")
+    if k_max is None:
+        k_max = int(own.get("k_max", 5))
     if channels is not None:
         channels = [str(c) for c in channels]
         known = list(dict.fromkeys(data.schema.channels))

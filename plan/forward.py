@@ -45,9 +45,10 @@ def one_blas_thread(fn):
     """Run ``fn`` with the BLAS libraries on one thread. Planning makes tens of thousands of
     small products (a few vectors against a classifier's support vectors or a category's
     members); a second BLAS thread only adds hand-over latency to each, and when the cores
-    are busy it waits for one: measured on the table's planning benchmark, with both cores
-    shared, assessing a plan with member effects took 48.9 s on two BLAS threads and 31.4 s
-    on one. The limit costs about 10 microseconds and nests."""
+    are busy it waits for one: on the table's planning benchmark (4 scenes, member effects),
+    with both cores busy exploring, assessing the plans took 48.9 s on two BLAS threads and
+    31.4 s on one; on an idle machine the two are alike (17-19 s, within the noise). The
+    limit costs about 10 microseconds and nests."""
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
         if not _BLAS:

@@ -262,3 +262,13 @@ def test_cluster_forms_categories_by_the_channels_asked_and_refuses_unknown_ones
     assert msg.strip().splitlines() == [f"error: no effect channel 'colour' in {pipeline / 'train.afford'}; "
                                         "its channels are visibility, position, shape"]
     assert not (tmp_path / "x.afford").exists()
+
+
+def test_the_grasp_scene_clusters_by_visibility_contact_point_and_touch_unless_told(tmp_path):
+    i, e, e2 = (str(tmp_path / n) for n in ("i.afford", "e.afford", "e2.afford"))
+    ok(["explore", "--scene", "grasp", "--interactions", "240", "--seed", "3", "--workers", "2", "-o", i])
+    ok(["cluster", i, "-o", e])
+    ok(["cluster", i, "-o", e2, "--channels", "visibility,border", "--kmax", "3"])
+    own, told = (read_artifact(p).manifest["effects"]["power-grasp"] for p in (e, e2))
+    assert (own["channels"], own["k_max"]) == (["visibility", "cp", "touch"], 4)
+    assert (told["channels"], told["k_max"]) == (["visibility", "border"], 3)

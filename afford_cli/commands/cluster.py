@@ -43,7 +43,7 @@ def cluster(
     path: InputPath,
     output: OutputPath,
     method: Annotated[Optional[Method], typer.Option(help="Channel-wise X-means with a Cartesian product (chapter 8), or one-level k-means (chapter 7). Default: the scene's own (crane-lift: kmeans), else hierarchical.")] = None,
-    kmax: Annotated[int, typer.Option("--kmax", min=1, max=20, help="Most categories X-means may find in one channel.")] = 5,
+    kmax: Annotated[Optional[int], typer.Option("--kmax", min=1, max=20, help="Most categories X-means may find in one channel. Default: the scene's own (grasp: 4), else 5.")] = None,
     k: Annotated[Optional[list[str]], typer.Option("--k", help="Clusters of k-means: K for every behaviour, or BEHAVIOUR=K for one (repeat the option).")] = None,
     prune: Annotated[Prune, typer.Option(help="Drop rare categories (chapter 8) or unpredictable ones (Algorithm 7).")] = Prune.frequency,
     min_fraction: Annotated[float, typer.Option("--min-fraction", min=0.0, max=0.5, help="Frequency pruning: smallest share a category must hold.")] = 0.03,
