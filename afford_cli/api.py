@@ -127,14 +127,14 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int | N
             k = {**own["k"], **({} if k is None else k if isinstance(k, dict) else {"*": k})}
     if channels is None and method == "hierarchical":
         channels = own.get("channels")
+        if channels is not None and (not isinstance(channels, list) or not all(isinstance(c, str) for c in channels)):
+            raise AffordError(f"{art.source}: its scene's clustering channels must be a list of channel names")
     if k_max is None:
         k_max = own.get("k_max", 5)
         if not isinstance(k_max, int) or isinstance(k_max, bool) or not 1 <= k_max <= 20:
             raise AffordError(f"{art.source}: its scene's clustering k_max must be a whole number 1-20, got {k_max!r}")
-    if channels is not None and (not isinstance(channels, (list, tuple)) or not all(isinstance(c, str) for c in channels)):
-        raise AffordError(f"{art.source}: its scene's clustering channels must be a list of channel names")
     if channels is not None:
-        channels = [str(c) for c in channels]
+        channels = [channels] if isinstance(channels, str) else [str(c) for c in channels]
         known = list(dict.fromkeys(data.schema.channels))
         unknown = [c for c in channels if c not in known]
         if unknown or not channels:

@@ -38,7 +38,11 @@ EFFECT_MODELS = ("members", "prototype")
 #: The object index a step on a behaviour without a target carries: it acts on the scene.
 SCENE = -1
 
-_BLAS = []
+@functools.cache
+def _blas():
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
 
 
 def one_blas_thread(fn):
@@ -48,14 +52,11 @@ def one_blas_thread(fn):
     are busy it waits for one: on the table's planning benchmark (4 scenes, member effects),
     with both cores busy exploring, assessing the plans took 48.9 s on two BLAS threads and
     31.4 s on one; on an idle machine the two are alike (17-19 s, within the noise). The
-    limit costs about 10 microseconds and nests."""
+    limit costs about 10 microseconds and nests; it wraps the searches, execution, the
+    imagined rollouts and ``prefetch`` (where ``predict`` and ``evaluate`` enter)."""
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        if not _BLAS:
-            from threadpoolctl import ThreadpoolController
-
-            _BLAS.append(ThreadpoolController())
-        with _BLAS[0].limit(limits=1, user_api="blas"):
+        with _blas().limit(limits=1, user_api="blas"):
             return fn(*args, **kwargs)
 
     return wrapper
@@ -402,7 +403,6 @@ class ForwardModel:
             return members.predict(self._member_input(self.behaviors[b], f, alpha), category)[1]
         return members.category_spread(category)
 
-    @one_blas_thread
     def draw_effect(self, f: np.ndarray, b: int, category: int, alpha: tuple, rng: np.random.Generator) -> np.ndarray:
         """One effect of category ``category`` on ``f`` as a world might give it: the
         predicted (mean) effect, with its geometry (where the object goes, what goals are

@@ -305,6 +305,10 @@ def _cases(p: Path):
          ["predict", "--seed", "1"]),
         ("member-effects-meta", "model.afford", {}, lambda m: m["member_effects"]["lift"].update(k="many"),
          ["predict", "--seed", "1"]),
+        ("scene-clustering-kmax", "train.afford", {}, lambda m: m["scene"].update(clustering={"k_max": "many"}),
+         ["cluster", "-o", "{out}"]),
+        ("scene-clustering-channels", "train.afford", {}, lambda m: m["scene"].update(clustering={"channels": "cp"}),
+         ["cluster", "-o", "{out}"]),
     ]
 
 
@@ -322,7 +326,8 @@ def forged(pipeline, tmp_path_factory):
     "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot", "nested-swap",
     "train-x-shape", "predictor-swapped-between-behaviours", "categories-count", "prototypes-strings",
     "edited-counts",
-    "missing-member", "member-effects-short", "member-effects-missing", "member-effects-category", "member-effects-meta"])
+    "missing-member", "member-effects-short", "member-effects-missing", "member-effects-category", "member-effects-meta",
+    "scene-clustering-kmax", "scene-clustering-channels"])
 def test_a_forged_file_is_one_sentence_and_exit_1(forged, pipeline, tmp_path, case):
     from typer.testing import CliRunner
 

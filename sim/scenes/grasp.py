@@ -29,6 +29,7 @@ What ground truth is kept (for reports only)
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -92,7 +93,7 @@ class GraspScene(TableScene):
 
     def describe(self) -> dict:
         d = super().describe()
-        d["clustering"] = {"channels": list(self.clustering["channels"]), "k_max": self.clustering["k_max"]}
+        d["clustering"] = copy.deepcopy(self.clustering)
         return d
 
     def check_layout(self, objects: list[ObjectSpec]) -> None:
