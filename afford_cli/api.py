@@ -163,28 +163,32 @@ def _per_behaviour(progress, data):
 
 
 def select_features(path: str, output: str, *, method: str = "relieff", top: int | None = None,
-                    group_channels: bool = False, kernel: str | None = None, seed: int = 0,
-                    progress: Callable[[int, int], None] | None = None) -> dict:
+                    group_channels: bool = False, kernel: str | None = None, score: str | None = None,
+                    seed: int = 0, progress: Callable[[int, int], None] | None = None) -> dict:
     """Rank the features by relevance to each behaviour's labels (ReliefF, Algorithm 3, or a
     wrapper) and keep the best: reads effects or interactions with given results, writes
-    ``features``; returns the summary ``afford select-features --json`` prints."""
+    ``features``; returns the summary ``afford select-features --json`` prints. ``score``
+    (``"accuracy"`` or ``"log_loss"``: what ReliefF's ranking cut scores) and ``kernel``
+    default to the scene's learner."""
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
     from afford.learn.affordances import rank_features
-    from afford.learning import features_members, learner_settings
+    from afford.learning import features_members, learner_settings, selection_score
 
     check_output(output)
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
     kernel_name, _ = learner_settings(art, data, kernel)
+    score_name = selection_score(art, data, score)
     start = time.perf_counter()
     relevance = rank_features(data, labels, method=method, top=top, seed=seed, group_channels=group_channels,
-                              kernel=kernel_name, progress=_per_behaviour(progress, data))
-    settings = {"method": method, "top": top, "group_channels": group_channels, "kernel": kernel_name}
+                              kernel=kernel_name, score=score_name, progress=_per_behaviour(progress, data))
+    settings = {"method": method, "top": top, "group_channels": group_channels, "kernel": kernel_name,
+                "score": score_name}
     arrays, meta, blobs = features_members(art, data, relevance, settings)
     write_artifact(output, artifact_bytes("features", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
-    return {"output": output, "seconds": round(time.perf_counter() - start, 3), "method": method,
+    return {"output": output, "seconds": round(time.perf_counter() - start, 3), "method": method, "score": score_name,
             "behaviors": {n: {"selected": r["selected"], **({"parameters": r["parameters"]} if "parameters" in r else {})}
                           for n, r in meta["relevance"].items()}}
 

@@ -161,6 +161,20 @@ def learner_settings(art: Artifact | None, data: Interactions, kernel: str | Non
     return kernel, folds
 
 
+SCORES = ("accuracy", "log_loss")
+
+
+def selection_score(art: Artifact | None, data: Interactions, score: str | None = None) -> str:
+    """What ReliefF's ranking cut scores: the one given, else the scene's (``learner`` in its
+    configuration, ``"score"``), else accuracy."""
+    learner = data.scene.get("learner") if isinstance(data.scene.get("learner"), dict) else {}
+    score = score if score is not None else learner.get("score", "accuracy")
+    if score not in SCORES:
+        raise AffordError(f"{art.source if art else 'the data'} asks for an unknown selection score {score!r}; "
+                          "give --score")
+    return str(score)
+
+
 def result_report(data: Interactions, labels: np.ndarray, b: int) -> list[dict]:
     """Per given result: id, name and count (the categories of a model whose labels were given)."""
     rows = np.flatnonzero(data.behavior == b)

@@ -111,12 +111,13 @@ def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max:
 
 
 def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "relieff", top: int | None = None,
-                  seed: int = 0, group_channels: bool = False, kernel: str = "rbf",
+                  seed: int = 0, group_channels: bool = False, kernel: str = "rbf", score: str = "accuracy",
                   progress: Callable[[int], None] | None = None) -> dict:
     """Feature relevance per behaviour (on rows with a kept category); ``{name: FeatureRelevance}``.
 
     ReliefF's ranking is cut where cross-validation of the SVM ``train`` will fit says
-    (``kernel``: an RBF machine, or a linear one as chapter 5's)."""
+    (``kernel``: an RBF machine, or a linear one as chapter 5's), by its accuracy or, with
+    ``score="log_loss"``, by its calibrated probabilities' log loss."""
     out = {}
     groups = feature_groups(data.schema) if group_channels else None
     _check_some_differ(data, labels, "tell apart")
@@ -134,7 +135,7 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
             if g is not None:
                 g = np.concatenate([g, _parameter_units(params, int(g.max()) + 1)])
         fr = FeatureRelevance(method=method, top=top, feature_groups=g, random_state=behaviour_seed(seed, b),
-                              estimator=prefix_estimator(kernel) if method == "relieff" else None)
+                              estimator=prefix_estimator(kernel) if method == "relieff" else None, scoring=score)
         out[name] = _split_parameters(fr.fit(X, y), d, params)
         if progress is not None:
             progress(b + 1)

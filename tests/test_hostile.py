@@ -309,6 +309,8 @@ def _cases(p: Path):
          ["cluster", "-o", "{out}"]),
         ("scene-clustering-channels", "train.afford", {}, lambda m: m["scene"].update(clustering={"channels": "cp"}),
          ["cluster", "-o", "{out}"]),
+        ("scene-learner-score", "effects.afford", {}, lambda m: m["scene"].update(learner={"score": "auc"}),
+         ["select-features", "-o", "{out}"]),
     ]
 
 
@@ -327,7 +329,7 @@ def forged(pipeline, tmp_path_factory):
     "train-x-shape", "predictor-swapped-between-behaviours", "categories-count", "prototypes-strings",
     "edited-counts",
     "missing-member", "member-effects-short", "member-effects-missing", "member-effects-category", "member-effects-meta",
-    "scene-clustering-kmax", "scene-clustering-channels"])
+    "scene-clustering-kmax", "scene-clustering-channels", "scene-learner-score"])
 def test_a_forged_file_is_one_sentence_and_exit_1(forged, pipeline, tmp_path, case):
     from typer.testing import CliRunner
 

@@ -248,6 +248,26 @@ def test_relieff_ranks_planted_features_first():
     assert np.array_equal(fr.transform(X), X[:, fr.selected_])
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_log_loss_cut_keeps_a_feature_that_makes_a_rare_effect_likelier(seed):
+    """Feature 0 makes the rare effect possible (40 % of the time, where x0 > 0.85) but never
+    the likeliest: the accuracy cut cannot see it, the log loss cut keeps it."""
+    from afford.learn.relevance import ranking_prefix
+
+    rng = np.random.default_rng(seed)
+    X = rng.random((1500, 5))
+    y = (rng.random(1500) < np.where(X[:, 0] > 0.85, 0.4, 0.0)).astype(int)
+    ranking = np.array([1, 0, 2, 3, 4])  # a noise feature ranked first
+    k_acc, _ = ranking_prefix(X, y, ranking, random_state=0)
+    k_loss, path = ranking_prefix(X, y, ranking, random_state=0, scoring="log_loss")
+    assert k_acc == 1
+    assert k_loss >= 2
+    by_k = {p["k"]: p["log_loss"] for p in path}
+    assert by_k[2] < by_k[1] - 0.02  # the feature's gain in log loss is real, not within noise
+    with pytest.raises(ValueError, match="scoring"):
+        ranking_prefix(X, y, ranking, scoring="auc")
+
+
 def test_forward_selection_finds_planted_features():
     X, y = relevance_data()
     selected, ranking, path = forward_selection(X, y, random_state=0)

@@ -264,7 +264,7 @@ def test_cluster_forms_categories_by_the_channels_asked_and_refuses_unknown_ones
     assert not (tmp_path / "x.afford").exists()
 
 
-def test_the_grasp_scene_clusters_by_visibility_contact_point_and_touch_unless_told(tmp_path):
+def test_the_grasp_scene_clusters_by_visibility_contact_point_and_touch_and_cuts_by_log_loss_unless_told(tmp_path):
     i, e, e2 = (str(tmp_path / n) for n in ("i.afford", "e.afford", "e2.afford"))
     ok(["explore", "--scene", "grasp", "--interactions", "240", "--seed", "3", "--workers", "2", "-o", i])
     ok(["cluster", i, "-o", e])
@@ -272,3 +272,9 @@ def test_the_grasp_scene_clusters_by_visibility_contact_point_and_touch_unless_t
     own, told = (read_artifact(p).manifest["effects"]["power-grasp"] for p in (e, e2))
     assert (own["channels"], own["k_max"]) == (["visibility", "cp", "touch"], 4)
     assert (told["channels"], told["k_max"]) == (["visibility", "border"], 3)
+    # and it cuts ReliefF's ranking by log loss unless told
+    f, f2 = str(tmp_path / "f.afford"), str(tmp_path / "f2.afford")
+    ok(["select-features", e, "-o", f])
+    ok(["select-features", e, "-o", f2, "--score", "accuracy"])
+    own, told = (read_artifact(p).manifest["relevance"]["power-grasp"] for p in (f, f2))
+    assert (own["score"], told["score"]) == ("log_loss", "accuracy")

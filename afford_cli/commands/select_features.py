@@ -13,6 +13,11 @@ from afford.options import InputPath, Json, KernelOption, OutputPath, Seed
 from afford.output import Output
 
 
+class Score(str, Enum):
+    accuracy = "accuracy"
+    log_loss = "log-loss"
+
+
 class Method(str, Enum):
     relieff = "relieff"
     forward = "forward"
@@ -23,9 +28,10 @@ def select_features(
     path: InputPath,
     output: OutputPath,
     method: Annotated[Method, typer.Option(help="ReliefF (Algorithm 3), forward selection (sequentialfs) or backward elimination (schemata search).")] = Method.relieff,
-    top: Annotated[Optional[int], typer.Option("--top", min=1, help="Keep this many features, best first (default: ReliefF's ranking cut where cross-validated accuracy is within one standard error of the best; the wrappers' own stopping rule).")] = None,
+    top: Annotated[Optional[int], typer.Option("--top", min=1, help="Keep this many features, best first (default: ReliefF's ranking cut where the cross-validated score (--score) is within one standard error of the best; the wrappers' own stopping rule).")] = None,
     group_channels: Annotated[bool, typer.Option("--group-channels", help="Wrappers move each 18-bin histogram as one unit.")] = False,
     kernel: KernelOption = None,
+    score: Annotated[Optional[Score], typer.Option(help="What ReliefF's ranking cut scores: the SVM's cross-validated accuracy, or its calibrated probabilities' log loss (a feature that makes a rare effect likelier without making it the likeliest counts). Default: the scene's own (grasp: log-loss), else accuracy.")] = None,
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
@@ -36,7 +42,8 @@ def select_features(
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress(f"selecting features ({method.value})", None) as update:
         result = run(path, output, method=method.value, top=top, group_channels=group_channels,
-                     kernel=kernel.value if kernel is not None else None, seed=seed, progress=update)
+                     kernel=kernel.value if kernel is not None else None,
+                     score=None if score is None else score.value.replace("-", "_"), seed=seed, progress=update)
 
     def render(console):
         table = Table(title=f"relevant features ({method.value})")
