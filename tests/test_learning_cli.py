@@ -230,9 +230,15 @@ def test_emulate_an_empty_table(pipeline):
 
     layouts = Path(__file__).resolve().parents[1] / "examples" / "layouts"
     out = json.loads(ok(["emulate", str(pipeline / "model.afford"), "--observe", str(layouts / "empty-table.toml"),
-                         "--start", str(layouts / "lift-start-1.toml"), "--json"]).stdout)
-    assert out["goal"] == ["0:visibility=0~0.5"]
-    assert {"plan", "success_probability", "reached", "replans"} <= set(out)
+                         "--start", str(layouts / "lift-start-1.toml"), "--max-replans", "0", "--json"]).stdout)
+    assert out["goal"] == ["0:visibility=0~0.5"]  # the observed table is empty: the object must go
+    assert out["found"] and 0 < out["success_probability"] <= 1
+    # with no replan the robot runs the plan until it is done or first surprised, and stops there
+    executed, planned = out["execution"]["executed"], out["plan"]
+    assert out["replans"] == 0 and 1 <= len(executed) <= len(planned)
+    assert [s["behavior"] for s in executed] == [s["behavior"] for s in planned[: len(executed)]]
+    assert all(s["as_predicted"] for s in executed[:-1])
+    assert out["reached"] or not executed[-1]["as_predicted"]
 
 
 def test_predict_answers_inverse_queries(pipeline):
