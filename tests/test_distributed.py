@@ -50,8 +50,12 @@ def _records(journal: Path) -> int:
 
 def _start_and_wait(tmp_path: Path, out: str, episodes: int, at_least: int):
     """Start an exploration and wait until its journal holds ``at_least`` episodes."""
+    # a shell that starts its jobs in the background (`make test &`) leaves SIGINT ignored,
+    # which the child would inherit, and Python then never raises KeyboardInterrupt: the
+    # child gets SIGINT's default back, as from a terminal
     proc = subprocess.Popen([*AFFORD, "explore", "--episodes", str(episodes), "--seed", "5", "-o", out],
-                            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.time() + 90
     journal = tmp_path / (out + ".partial")
     while time.time() < deadline:
