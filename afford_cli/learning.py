@@ -145,11 +145,17 @@ def _feature_indices(art: Artifact, member: str, d: int) -> np.ndarray:
 _MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created", "command", "seed", "parents", "members"}
 
 
+def _scene_learner(data: Interactions) -> dict:
+    """The scene's learner settings (``learner`` in its configuration), or none."""
+    learner = data.scene.get("learner")
+    return learner if isinstance(learner, dict) else {}
+
+
 def learner_settings(art: Artifact | None, data: Interactions, kernel: str | None = None,
                      folds: int | None = None) -> tuple[str, int]:
     """The kernel and folds to learn with: those given, else the scene's (``learner`` in its
     configuration), else the RBF kernel and 3 folds."""
-    learner = data.scene.get("learner") if isinstance(data.scene.get("learner"), dict) else {}
+    learner = _scene_learner(data)
     kernel = kernel if kernel is not None else str(learner.get("kernel", "rbf"))
     if kernel not in ("rbf", "linear"):
         raise AffordError(f"{art.source if art else 'the data'} asks for an unknown kernel {kernel!r}; give --kernel")
@@ -167,8 +173,7 @@ SCORES = ("accuracy", "log_loss")
 def selection_score(art: Artifact | None, data: Interactions, score: str | None = None) -> str:
     """What ReliefF's ranking cut scores: the one given, else the scene's (``learner`` in its
     configuration, ``"score"``), else accuracy."""
-    learner = data.scene.get("learner") if isinstance(data.scene.get("learner"), dict) else {}
-    score = score if score is not None else learner.get("score", "accuracy")
+    score = score if score is not None else _scene_learner(data).get("score", "accuracy")
     if score not in SCORES:
         raise AffordError(f"{art.source if art else 'the data'} asks for an unknown selection score {score!r}; "
                           "give --score")
