@@ -96,3 +96,63 @@ def test_grasp_tables_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     assert 0.0 <= doc["summary"]["map_agreement"] <= 1.0
     assert "Table 9.1" in (tmp_path / "tables_9_1_9_2_grasp.md").read_text()
     assert (tmp_path / "tables_9_1_9_2_grasp.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def _critical(tmp_path, name: str) -> dict:
+    subprocess.run([sys.executable, str(SCRIPTS / f"{name}.py"), "--quick", "--episodes", "30", "--orientations", "0,45",
+                    "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / f"{name}.json").read_text())
+    assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
+    behaviors = [r["behavior"] for r in doc["rows"][:3]]
+    assert [(r["orientation"], r["behavior"]) for r in doc["rows"]] == [(o, b) for o in (0.0, 45.0) for b in behaviors]
+    assert set(behaviors) == {"go-forward", "turn-left-20", "turn-right-20"}
+    for r in doc["rows"]:
+        assert r["actual"] is not None and doc["range"][0] < r["actual"] < doc["range"][1]
+        assert r["predicted"] is None or doc["range"][0] <= r["predicted"] <= doc["range"][1]
+        assert r["error"] is None or abs(r["error"] - (r["predicted"] - r["actual"])) < 0.01
+        assert set(r["thesis"]) == {"predicted", "actual"}
+    s = doc["summary"]
+    assert s["cells"] == 6 and s["within_bound"] <= s["both_exist"] <= 6
+    assert (tmp_path / f"{name}.png").read_bytes()[:4] == b"\x89PNG"
+    return {(r["orientation"], r["behavior"]): r for r in doc["rows"]}
+
+
+def test_table_5_1_critical_slopes_change_with_the_ramps_orientation_in_physx(tmp_path):
+    cells = _critical(tmp_path, "table_5_1_ramps")
+    # head-on the robot gives up near 9 degrees; met at 45 degrees it climbs much steeper ramps
+    assert 5 < cells[0.0, "go-forward"]["actual"] < 14
+    assert cells[45.0, "go-forward"]["actual"] > cells[0.0, "go-forward"]["actual"] + 5
+    # turning towards the direction the ramp climbs meets it head-on again; turning away, more obliquely
+    assert cells[45.0, "turn-left-20"]["actual"] < cells[45.0, "turn-right-20"]["actual"] - 10
+    assert cells[0.0, "go-forward"]["thesis"] == {"predicted": 7.5, "actual": 8}
+    assert "Table 5.1" in (tmp_path / "table_5_1_ramps.md").read_text()
+    bad = subprocess.run([sys.executable, str(SCRIPTS / "table_5_1_ramps.py"), "--orientations", "100"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 1 and bad.stderr.strip() == "error: orientation 100 is outside -90..90 degrees"
+
+
+def test_table_5_2_critical_gap_widths_change_with_the_gaps_orientation_in_physx(tmp_path):
+    cells = _critical(tmp_path, "table_5_2_gaps")
+    # a gap the robot meets square is crossed up to about 20 cm; met obliquely, wider ones are
+    assert 12 < cells[0.0, "go-forward"]["actual"] < 25
+    assert cells[45.0, "go-forward"]["actual"] > cells[0.0, "go-forward"]["actual"] + 2
+    assert cells[0.0, "go-forward"]["thesis"] == {"predicted": 12, "actual": 12}
+    assert "Table 5.2" in (tmp_path / "table_5_2_gaps.md").read_text()
+
+
+def test_fig_5_5_finds_the_robots_body_in_physx_and_maps_the_model_beside_it(tmp_path):
+    subprocess.run([sys.executable, str(SCRIPTS / "fig_5_5_body.py"), "--quick", "--episodes", "30", "--step", "9",
+                    "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "fig_5_5_body.json").read_text())
+    actual = {r["boundary"]: r["actual"] for r in doc["rows"]}
+    assert set(actual) == {"left", "right", "depth", "height"} and doc["step"] == 0.09
+    # a 10 cm box blocks the 33 cm-wide robot as far to the left as to the right of its path (16.5 + 5 cm),
+    assert 0.15 < actual["left"] < 0.30 and abs(actual["left"] + actual["right"]) <= 0.09
+    # it is driven under when hung above the 47 cm body, and is not reached when far ahead
+    assert 0.42 < actual["height"] < 0.6 and 0.7 < actual["depth"] < 1.2
+    places = {(c["map"], c["x"], c["y"], c["z"]): c for c in doc["maps"]}
+    assert places["lateral", 0.6, 0.0, 0.0]["actual"] == 1 and places["lateral", 0.6, 0.45, 0.0]["actual"] == 0
+    assert all(c["predicted"] in (0, 1) for c in doc["maps"])
+    assert 0.0 <= doc["agreement"]["lateral"] <= 1.0 and 0 <= doc["within_one_step"] <= 4
+    assert "Figure 5.5" in (tmp_path / "fig_5_5_body.md").read_text()
+    assert (tmp_path / "fig_5_5_body.png").read_bytes()[:4] == b"\x89PNG"
