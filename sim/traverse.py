@@ -370,8 +370,10 @@ def _round(v: float) -> float:
 
 def sample_clutter(rng: np.random.Generator, max_objects: int = 12, size_range: tuple[float, float] = (0.10, 0.40),
                    x_range: tuple[float, float] = (0.3, 2.0), y_range: tuple[float, float] = (-1.0, 1.0),
-                   shapes: tuple[str, ...] = SOLID_SHAPES, robot: MobileRobotConfig = MobileRobotConfig()) -> TraverseLayout:
-    """0-``max_objects`` loose objects of random shape, size, place and yaw (thesis 5.6.1)."""
+                   shapes: tuple[str, ...] = SOLID_SHAPES, robot: MobileRobotConfig = MobileRobotConfig(),
+                   min_objects: int = 0) -> TraverseLayout:
+    """``min_objects``-``max_objects`` loose objects of random shape (one of ``shapes``), size,
+    place and yaw (thesis 5.6.1)."""
     lo, hi = size_range
     if not (0.01 <= lo <= hi <= 1.0):
         raise DataError(f"object sizes must satisfy 0.01 <= min <= max <= 1.0 m, got {lo} and {hi}")
@@ -383,7 +385,7 @@ def sample_clutter(rng: np.random.Generator, max_objects: int = 12, size_range: 
         return Item(shape, size, pos, _round(g.uniform(0.0, 360.0)))
 
     items: list[Item] = []
-    for _ in range(int(rng.integers(max_objects + 1))):
+    for _ in range(int(rng.integers(min_objects, max_objects + 1))):
         it = _place(rng, make, items, robot)
         if it is not None:
             items.append(it)

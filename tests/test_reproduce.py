@@ -156,3 +156,24 @@ def test_fig_5_5_finds_the_robots_body_in_physx_and_maps_the_model_beside_it(tmp
     assert 0.0 <= doc["agreement"]["lateral"] <= 1.0 and 0 <= doc["within_one_step"] <= 4
     assert "Figure 5.5" in (tmp_path / "fig_5_5_body.md").read_text()
     assert (tmp_path / "fig_5_5_body.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_table_5_3_trains_on_some_shapes_and_tests_on_each_alone(tmp_path):
+    subprocess.run([sys.executable, str(SCRIPTS / "table_5_3_novel.py"), "--quick", "--episodes", "24",
+                    "--test-episodes", "16", "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "table_5_3_novel.json").read_text())
+    rows = doc["rows"]
+    assert len(rows) == 60 and {r["case"] for r in rows} == set(range(1, 16))
+    assert all(r["novel"] == (r["test"] not in r["train"]) for r in rows)
+    cell = {(r["case"], r["test"]): r for r in rows}
+    share = doc["summary"]["traversable"]
+    # PhysX, not the shape's name: a sphere in the path rolls away, most boxes of 10-40 cm do not move
+    assert share["sphere"] == 1.0 and share["box"] < 0.5
+    # trained on spheres alone the robot has only ever succeeded: it expects to pass everything (thesis case 4)
+    for s, v in share.items():
+        assert cell[4, s]["accuracy"] == v
+    # having met boxes that block, it tells blocking boxes apart
+    assert cell[2, "box"]["accuracy"] > cell[4, "box"]["accuracy"] + 0.2
+    assert cell[15, "sphere"]["thesis"] == 1.0 and cell[2, "sphere"]["thesis"] == 0.31
+    assert "Table 5.3" in (tmp_path / "table_5_3_novel.md").read_text()
+    assert (tmp_path / "table_5_3_novel.png").read_bytes()[:4] == b"\x89PNG"

@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from afford.features.errors import DataError
 from afford.sim.layout import LayoutError
 from afford.sim.traverse import (
     ROTATIONS, Gap, Item, Ramp, TraverseLayout, TraverseWorld, check_layout, layout_toml, parse_layout,
@@ -210,3 +211,20 @@ def test_a_wall_ahead_stops_the_robot_and_open_floor_does_not():
     blocked = forward(scene.build(near_wall, np.random.default_rng(0)), None, np.zeros(0))
     free = forward(scene.build(in_the_middle, np.random.default_rng(0)), None, np.zeros(0))
     assert blocked.result != success and free.result == success
+
+
+# -- traverse-one (5.6.4.1): one object of the chosen shapes -------------------------------------
+
+def test_one_object_of_the_chosen_shapes_stands_in_front_of_the_robot():
+    from afford.sim.registry import make_scene
+
+    scene = make_scene("traverse-one", shapes="sphere,box")
+    assert scene.shapes == ("box", "sphere") and scene.describe()["shapes"] == ["box", "sphere"]
+    layouts = [scene.sample(np.random.default_rng(s)) for s in range(40)]
+    assert all(len(lay.items) == 1 for lay in layouts)
+    assert {lay.items[0].shape for lay in layouts} == {"box", "sphere"}
+    assert all(0.35 <= lay.items[0].position[0] <= 0.95 and abs(lay.items[0].position[1]) <= 0.3 for lay in layouts)
+    again = make_scene("traverse-one", **scene.options_from(scene.describe()))
+    assert again.shapes == scene.shapes
+    with pytest.raises(DataError, match="unknown shape 'cube'; the shapes are box, cylinder, lying-cylinder, sphere"):
+        make_scene("traverse-one", shapes="box,cube")
