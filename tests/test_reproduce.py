@@ -177,3 +177,21 @@ def test_table_5_3_trains_on_some_shapes_and_tests_on_each_alone(tmp_path):
     assert cell[15, "sphere"]["thesis"] == 1.0 and cell[2, "sphere"]["thesis"] == 0.31
     assert "Table 5.3" in (tmp_path / "table_5_3_novel.md").read_text()
     assert (tmp_path / "table_5_3_novel.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_furniture_never_met_in_training_is_judged_beside_the_thesis(tmp_path):
+    subprocess.run([sys.executable, str(SCRIPTS / "sec_5_6_4_2_furniture.py"), "--quick", "--episodes", "30",
+                    "--test-episodes", "10", "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "sec_5_6_4_2_furniture.json").read_text())
+    rows = {r["furniture"]: r for r in doc["rows"]}
+    assert set(rows) == {"wooden-table", "iron-table", "chair"}
+    for r in rows.values():
+        assert r["n_test"] == 10 and 0.0 <= r["accuracy"] <= 1.0 and 0.0 <= r["all_moves"] <= 1.0
+        assert r["majority"] == max(r["not_traversable"], 1 - r["not_traversable"])
+    # the chair's seat is below the robot's top: in front of it, most of the chair's situations block
+    assert rows["chair"]["not_traversable"] >= 0.5
+    assert rows["chair"]["thesis"] == {"accuracy": 0.947, "not_traversable": 0.684}
+    assert (tmp_path / "sec_5_6_4_2_furniture.png").read_bytes()[:4] == b"\x89PNG"
+    bad = subprocess.run([sys.executable, str(SCRIPTS / "sec_5_6_4_2_furniture.py"), "--model", str(tmp_path / "none.afford")],
+                         capture_output=True, text=True)
+    assert bad.returncode == 1 and bad.stderr.strip() == f"error: no model file {tmp_path / 'none.afford'}"

@@ -228,3 +228,40 @@ def test_one_object_of_the_chosen_shapes_stands_in_front_of_the_robot():
     assert again.shapes == scene.shapes
     with pytest.raises(DataError, match="unknown shape 'cube'; the shapes are box, cylinder, lying-cylinder, sphere"):
         make_scene("traverse-one", shapes="box,cube")
+
+
+# -- traverse-furniture (5.6.4.2): tables and a chair of fixed boxes -----------------------------
+
+def _go_forward_through(items) -> bool:
+    from afford.sim.registry import make_scene
+    from afford.sim.traverse import TraverseLayout
+
+    scene = make_scene("traverse-furniture")
+    layout = TraverseLayout(items=items)
+    scene.check_layout(layout)
+    forward = scene.behaviors[0]
+    return forward(scene.build(layout, np.random.default_rng(0)), None, np.zeros(0)).result == list(scene.results).index("success")
+
+
+def test_the_robot_drives_under_a_high_table_between_its_legs_but_not_under_a_low_one():
+    from afford.sim.furniture import place, wooden_table
+
+    # the table's long side across the path: 1.2 m between the legs, the top 0.7 m or 0.4 m up
+    assert _go_forward_through(place(wooden_table(0.7, 1.2, 0.70), 0.75, 0.0, 0.0))
+    assert not _go_forward_through(place(wooden_table(0.7, 1.2, 0.40), 0.75, 0.0, 0.0))
+    # a leg straight ahead stops it, however high the top
+    assert not _go_forward_through(place(wooden_table(0.7, 1.2, 0.70), 0.75 + 0.29, 0.56, 0.0))
+
+
+def test_an_iron_tables_bars_stop_the_robot_unless_they_are_above_it():
+    from afford.sim.furniture import iron_table, place
+
+    assert not _go_forward_through(place(iron_table(0.7, 1.2, 0.75, bar=0.15), 0.75, 0.0, 0.0))
+    assert _go_forward_through(place(iron_table(0.7, 1.2, 0.75, bar=0.60), 0.75, 0.0, 0.0))
+
+
+def test_a_chairs_seat_below_the_robots_top_stops_it():
+    from afford.sim.furniture import chair, place
+
+    assert not _go_forward_through(place(chair(), 0.6, 0.0, 90.0))
+    assert _go_forward_through(place(chair(), 0.6, 0.7, 90.0))  # beside the path

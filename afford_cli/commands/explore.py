@@ -150,6 +150,7 @@ def explore(
     layers: Annotated[Optional[int], typer.Option("--layers", min=1, max=8, help="Overlapping grid layers (4 in chapter 5, 1 in chapter 6).")] = None,
     room: Annotated[Optional[int], typer.Option("--room", min=0, help="Which room (its seed) the robot explores (traverse-room: chapter 6 learns in one room and tests in another; 0 by default).")] = None,
     shapes: Annotated[Optional[str], typer.Option("--shapes", metavar="S1,S2", help="The shapes the scene's objects are drawn from (traverse-one, thesis 5.6.4.1: box, cylinder, lying-cylinder, sphere; all four by default).")] = None,
+    furniture: Annotated[Optional[str], typer.Option("--furniture", help="The piece in front of the robot (traverse-furniture, thesis 5.6.4.2): wooden-table, iron-table or chair.")] = None,
     backend: Annotated[Backend, typer.Option("--backend", help="Where episodes run: loky (processes on this machine) or dask (a LocalCluster of --workers on 127.0.0.1, or the cluster at --scheduler; needs the optional dask extra). The same --seed gives the same bytes on either.")] = Backend.loky,
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", metavar="ADDRESS", help="A running Dask scheduler (tcp://HOST:PORT) to explore on, with --backend dask; its workers need afford installed.")] = None,
     resume: Annotated[bool, typer.Option("--resume", help="Continue the interrupted run whose finished episodes are journaled in OUTPUT.partial/ (same options); starts afresh if there is none.")] = False,
@@ -203,7 +204,7 @@ def explore(
     check_output(output)
     out = Output(json, stdout_busy=writes_stdout(output))
     sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps, grid=grid, layers=layers, room=room,
-                    shapes=shapes)
+                    shapes=shapes, furniture=furniture)
     data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
                           workers=workers, episode_start=episode_start or 0, backend=backend.value,
                           scheduler=scheduler, resume=resume)

@@ -25,3 +25,18 @@ def parser(doc: str):
     ap.add_argument("--out", default="reproduce", help="where the .md, .png and .json go")
     ap.add_argument("--workers", type=int, default=2)
     return ap
+
+
+def train_model(scene: str, args, directory: Path) -> str:
+    """Explore ``scene`` and learn as ``afford select-features | afford train`` does; the
+    model's path in ``directory``. ``args.episodes`` sizes the exploration if given; else 100
+    environments in quick mode and 5000 interactions in full mode (the README's models)."""
+    import afford
+
+    size = {"episodes": args.episodes} if args.episodes else (
+        {"episodes": 100} if args.quick else {"interactions": 5000})
+    data = afford.explore(scene, seed=args.seed, workers=args.workers, **size)
+    afford.save(data, str(directory / "train.afford"), seed=args.seed)
+    afford.select_features(str(directory / "train.afford"), str(directory / "features.afford"), seed=args.seed)
+    afford.train(str(directory / "features.afford"), str(directory / "model.afford"), seed=args.seed)
+    return str(directory / "model.afford")

@@ -35,7 +35,7 @@ from typing import Callable
 
 import numpy as np
 
-from _common import commit
+from _common import commit, train_model
 
 
 @dataclass(frozen=True)
@@ -146,18 +146,6 @@ def predicted_column(sweep: Sweep, orientation: float, model_path: str, seed: in
     return {"values": [float(v) for v in values], "behaviors": out}
 
 
-def train_model(sweep: Sweep, args, directory: Path) -> str:
-    """Explore the scene and learn as ``afford select-features | afford train`` does; the model's path."""
-    import afford
-
-    size = {"episodes": args.episodes} if args.episodes else (
-        {"episodes": 100} if args.quick else {"interactions": 5000})
-    data = afford.explore(sweep.scene, seed=args.seed, workers=args.workers, **size)
-    afford.save(data, str(directory / "train.afford"), seed=args.seed)
-    afford.select_features(str(directory / "train.afford"), str(directory / "features.afford"), seed=args.seed)
-    afford.train(str(directory / "features.afford"), str(directory / "model.afford"), seed=args.seed)
-    return str(directory / "model.afford")
-
 
 def _check_model(sweep: Sweep, path: str) -> None:
     import afford
@@ -190,7 +178,7 @@ def run(sweep: Sweep, args) -> dict:
     step = sweep.fine * (2 if args.quick else 1)
     with tempfile.TemporaryDirectory() as tmp:
         try:
-            model_path = args.model or train_model(sweep, args, Path(tmp))
+            model_path = args.model or train_model(sweep.scene, args, Path(tmp))
             if args.model:
                 _check_model(sweep, args.model)
         except (AffordError, DataError) as exc:  # too few environments; a model of another scene

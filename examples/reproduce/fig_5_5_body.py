@@ -36,7 +36,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser  # noqa: E402
+from _common import commit, parser, train_model  # noqa: E402
 
 NAME = "fig_5_5_body"
 SCENE = "traverse-body"
@@ -118,16 +118,6 @@ def boundaries(grid: list[dict], key: str, step: float) -> dict:
             "depth": _edge(column, cx, +1, step, xs), "height": _edge(height, 0.0, +1, step, zs)}
 
 
-def train_model(args, directory: Path) -> str:
-    import afford
-
-    size = {"episodes": args.episodes} if args.episodes else ({"episodes": 100} if args.quick else {"interactions": 5000})
-    data = afford.explore(SCENE, seed=args.seed, workers=args.workers, **size)
-    afford.save(data, str(directory / "train.afford"), seed=args.seed)
-    afford.select_features(str(directory / "train.afford"), str(directory / "features.afford"), seed=args.seed)
-    afford.train(str(directory / "features.afford"), str(directory / "model.afford"), seed=args.seed)
-    return str(directory / "model.afford")
-
 
 def main() -> None:
     ap = parser(__doc__)
@@ -148,7 +138,7 @@ def main() -> None:
     n = max(1, args.workers)
     with tempfile.TemporaryDirectory() as tmp:
         try:
-            model_path = args.model or train_model(args, Path(tmp))
+            model_path = args.model or train_model(SCENE, args, Path(tmp))
             if BEHAVIOR not in __import__("afford").load_model(model_path).names:
                 raise AffordError(f"{model_path} has no {BEHAVIOR} behaviour; give a model of the traverse robot")
         except (AffordError, DataError) as exc:
