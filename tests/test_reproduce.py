@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+
 SCRIPTS = Path(__file__).parents[1] / "examples" / "reproduce"
 
 
@@ -195,3 +197,22 @@ def test_furniture_never_met_in_training_is_judged_beside_the_thesis(tmp_path):
     bad = subprocess.run([sys.executable, str(SCRIPTS / "sec_5_6_4_2_furniture.py"), "--model", str(tmp_path / "none.afford")],
                          capture_output=True, text=True)
     assert bad.returncode == 1 and bad.stderr.strip() == f"error: no model file {tmp_path / 'none.afford'}"
+
+
+def test_fig_5_7_5_13_relevance_lies_where_the_move_heads_and_accuracy_is_tallied_per_feature_count(tmp_path):
+    subprocess.run([sys.executable, str(SCRIPTS / "fig_5_7_5_13_relevance.py"), "--quick", "--episodes", "30",
+                    "--test-episodes", "20", "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "fig_5_7_5_13_relevance.json").read_text())
+    maps = doc["maps"]
+    assert len(maps) == 7 and all(np.shape(m["cells"]) == (4, 5, 5) for m in maps.values())
+    # turning left the robot heads into what lies on the left of its range image, and right, the right
+    assert maps["turn-left-60"]["centre_of_relevance"] < 0 < maps["turn-right-60"]["centre_of_relevance"]
+    relieff = [r for r in doc["economy"] if r["method"] == "relieff"]
+    forward = [r for r in doc["economy"] if r["method"] == "forward"]
+    assert [r["n"] for r in relieff] == [1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 3900]
+    assert [r["n"] for r in forward] == [1, 2, 4, 8]
+    assert all(r["worst"] <= r["median"] <= r["best"] for r in doc["economy"])
+    assert relieff[0]["thesis"] == 0.64 and forward[2]["thesis"] == 0.80
+    for shares in (doc["categories"]["go-forward"], doc["categories"]["all_moves"]):
+        assert abs(sum(shares.values()) - 1.0) < 1e-3
+    assert (tmp_path / "fig_5_7_5_13_relevance.png").read_bytes()[:4] == b"\x89PNG"
