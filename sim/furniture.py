@@ -21,7 +21,7 @@ import numpy as np
 
 from afford.sim.traverse import Item
 
-__all__ = ["KINDS", "place", "wooden_table", "iron_table", "chair", "sample_furniture"]
+__all__ = ["KINDS", "place", "piece", "footprint", "wooden_table", "iron_table", "chair", "sample_furniture"]
 
 #: The kinds of furniture, as the thesis's Figure 5.8 shows them.
 KINDS = ("wooden-table", "iron-table", "chair")
@@ -82,25 +82,40 @@ def chair(seat: float = 0.42, seat_height: float = 0.45, back: float = 0.90, leg
     return boxes
 
 
+def piece(rng: np.random.Generator, kind: str) -> list[Box]:
+    """One piece of ``kind`` of random dimensions, in its own frame (see :func:`sample_furniture`)."""
+    if kind == "wooden-table":
+        return wooden_table(rng.uniform(0.9, 1.4), rng.uniform(0.6, 0.9), rng.uniform(0.35, 0.80))
+    if kind == "iron-table":
+        height = rng.uniform(0.55, 0.80)
+        return iron_table(rng.uniform(1.0, 1.4), rng.uniform(0.6, 0.8), height, rng.uniform(0.05, height - 0.06))
+    if kind == "chair":
+        return chair()
+    raise ValueError(f"unknown furniture {kind!r}; the kinds are {', '.join(KINDS)}")
+
+
+def footprint(boxes: list[Box], x: float, y: float, yaw: float):
+    """The piece's bounding rectangle on the floor, posed: ((x, y), (half x, half y), yaw)."""
+    hx = max(abs(bx) + sx / 2 for (sx, _, _), (bx, _), _ in boxes)
+    hy = max(abs(by) + sy / 2 for (_, sy, _), (_, by), _ in boxes)
+    return (float(x), float(y)), (float(hx), float(hy)), float(yaw)
+
+
+#: Where each kind stands in front of the robot in ``traverse-furniture``: x and y ranges.
+_IN_FRONT = {"wooden-table": ((0.5, 1.3), (-0.4, 0.4)), "iron-table": ((0.5, 1.3), (-0.6, 0.6)),
+             "chair": ((0.4, 1.2), (-0.55, 0.55))}
+
+
 def sample_furniture(rng: np.random.Generator, kind: str) -> tuple[Item, ...]:
     """One piece of ``kind`` of random dimensions (within the thesis's descriptions) and pose.
 
     The wooden table is 0.9-1.4 x 0.6-0.9 m and 0.35-0.80 m high (so it can sometimes be
     driven under), within 0.5-1.3 m ahead and 0.4 m to either side; the iron table 1.0-1.4 x
-    0.6-0.8 m, 0.55-0.80 m high, its bars from 0.05 m above the floor to just under the top, shifted up to 0.6 m to
-    either side; the chair fixed in shape, 0.4-1.3 m ahead and 0.6 m to either side. Every
-    piece is turned any way (0-360 degrees).
+    0.6-0.8 m, 0.55-0.80 m high, its bars from 0.05 m above the floor to just under the top,
+    shifted up to 0.6 m to either side; the chair fixed in shape, 0.4-1.2 m ahead and 0.55 m
+    to either side. Every piece is turned any way (0-360 degrees).
     """
-    if kind == "wooden-table":
-        boxes = wooden_table(rng.uniform(0.9, 1.4), rng.uniform(0.6, 0.9), rng.uniform(0.35, 0.80))
-        x, y = rng.uniform(0.5, 1.3), rng.uniform(-0.4, 0.4)
-    elif kind == "iron-table":
-        height = rng.uniform(0.55, 0.80)
-        boxes = iron_table(rng.uniform(1.0, 1.4), rng.uniform(0.6, 0.8), height, rng.uniform(0.05, height - 0.06))
-        x, y = rng.uniform(0.5, 1.3), rng.uniform(-0.6, 0.6)
-    elif kind == "chair":
-        boxes = chair()
-        x, y = rng.uniform(0.4, 1.3), rng.uniform(-0.6, 0.6)
-    else:
-        raise ValueError(f"unknown furniture {kind!r}; the kinds are {', '.join(KINDS)}")
+    boxes = piece(rng, kind)
+    (x0, x1), (y0, y1) = _IN_FRONT[kind]
+    x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
     return place(boxes, float(x), float(y), float(rng.uniform(0.0, 360.0)))
