@@ -15,7 +15,7 @@ from importlib import import_module
 
 __all__ = [
     "__version__", "AffordError", "Model", "cluster", "explore", "load", "load_interactions", "load_labels",
-    "load_model", "make_scene", "parse_goal", "save", "scene_names", "select_features", "to_frame", "train", "world",
+    "load_model", "make_scene", "navigate", "parse_goal", "save", "scene_names", "select_features", "to_frame", "train", "world",
 ]
 
 

@@ -34,7 +34,7 @@ from afford.artifacts import read_artifact
 
 __all__ = [
     "AffordError", "load", "load_interactions", "load_labels", "load_model", "save", "Model",
-    "scene_names", "make_scene", "explore", "merge", "scene_and_layout", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
+    "scene_names", "make_scene", "explore", "merge", "navigate", "scene_and_layout", "world", "parse_goal", "to_frame", "cluster", "select_features", "train",
 ]
 
 
@@ -530,6 +530,21 @@ class Model(LoadedModel):
 
 #: Geometry features shown per entity, at most (an environment of 3900 features shows none).
 _SHOWN = 12
+
+
+def navigate(model, *, scene: str = "room", controller: str = "aggressive", seed: int = 0, room: int | None = None,
+             steps: int = 100, threshold: float = 0.5) -> dict:
+    """Drive the mobile robot through a room with a traverse model (a path or a loaded model),
+    as ``afford navigate`` does (thesis 5.6.5): the report, with ``distance_m``, ``moves``,
+    ``failed_moves``, ``stuck`` and the true ``path`` in the room's frame. ``seed`` picks the
+    room (unless ``room``) and where the robot starts."""
+    from afford.navigation import navigate as run
+
+    loaded = load_model(model) if isinstance(model, (str, os.PathLike)) else model
+    sc = make_scene(scene)
+    if "room" in sc.options:
+        sc = make_scene(scene, room=seed if room is None else room)
+    return run(loaded, sc, controller, seed=seed, steps=steps, threshold=threshold)
 
 
 def _named(schema, f: np.ndarray) -> dict:

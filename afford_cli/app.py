@@ -14,8 +14,8 @@ from typing import Annotated, Callable
 import typer
 
 from afford.commands import (
-    cluster, demo, emulate, evaluate, explore, export, inspect, merge, pddl, plan, predict, scenes, select_features,
-    train,
+    cluster, demo, emulate, evaluate, explore, export, inspect, merge, navigate, pddl, plan, predict, scenes,
+    select_features, train,
 )
 from afford.errors import AffordError, Interrupted
 from afford.features.errors import DataError
@@ -71,7 +71,7 @@ def _guarded(command: Callable) -> Callable:
 for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore), ("cluster", cluster.cluster),
                         ("select-features", select_features.select_features), ("train", train.train),
                         ("evaluate", evaluate.evaluate), ("predict", predict.predict),
-                        ("plan", plan.plan), ("emulate", emulate.emulate), ("pddl", pddl.pddl),
+                        ("plan", plan.plan), ("emulate", emulate.emulate), ("navigate", navigate.navigate), ("pddl", pddl.pddl),
                         ("merge", merge.merge), ("inspect", inspect.inspect), ("export", export.export), ("demo", demo.demo)):
     app.command(_name)(_guarded(_command))
 

@@ -34,6 +34,19 @@ def pipeline(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def traverse_learned(tmp_path_factory):
+    """A small traverse pipeline, made once: 36 training and 8 test environments, features, model."""
+    from tests.clitools import ok
+
+    d = tmp_path_factory.mktemp("traverse")
+    ok(["explore", "--scene", "traverse", "--episodes", "36", "--seed", "5", "--workers", "2", "-o", str(d / "train.afford")])
+    ok(["explore", "--scene", "traverse", "--episodes", "8", "--seed", "6", "-o", str(d / "test.afford")])
+    ok(["select-features", str(d / "train.afford"), "-o", str(d / "features.afford")])
+    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
+    return d
+
+
+@pytest.fixture(scope="session")
 def table():
     return get_scene("table")()
 

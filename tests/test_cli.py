@@ -95,7 +95,7 @@ def test_errors_are_one_sentence_without_traceback(tmp_path):
     assert lines == [f"error: {bogus} is not an afford file"]
     proc = _run("explore", "--scene", "kitchen", "-o", str(tmp_path / "x.afford"))
     assert proc.returncode == 1
-    assert proc.stderr.decode().strip().splitlines() == ["error: unknown scene 'kitchen'; known scenes: crane-lift, grasp, table, traverse, traverse-body, traverse-furniture, traverse-gaps, traverse-one, traverse-ramps, traverse-room"]
+    assert proc.stderr.decode().strip().splitlines() == ["error: unknown scene 'kitchen'; known scenes: crane-lift, grasp, room, table, traverse, traverse-body, traverse-furniture, traverse-gaps, traverse-one, traverse-ramps, traverse-room"]
 
 
 def test_debug_shows_the_traceback(tmp_path):

@@ -216,3 +216,17 @@ def test_fig_5_7_5_13_relevance_lies_where_the_move_heads_and_accuracy_is_tallie
     for shares in (doc["categories"]["go-forward"], doc["categories"]["all_moves"]):
         assert abs(sum(shares.values()) - 1.0) < 1e-3
     assert (tmp_path / "fig_5_7_5_13_relevance.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_navigation_runs_every_controller_in_every_room_beside_the_random_baseline(tmp_path, traverse_learned):
+    subprocess.run([sys.executable, str(SCRIPTS / "sec_5_6_5_navigation.py"), "--quick", "--model",
+                    str(traverse_learned / "model.afford"), "--rooms", "2", "--steps", "6", "--workers", "2",
+                    "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "sec_5_6_5_navigation.json").read_text())
+    assert [(r["room"], r["controller"]) for r in doc["rows"]] == [(k, c) for k in (0, 1) for c in ("aggressive", "cautious", "random")]
+    for c, s in doc["summary"].items():
+        runs = [r for r in doc["rows"] if r["controller"] == c]
+        assert s["runs"] == 2 and s["mean_distance_m"] == round(sum(r["distance_m"] for r in runs) / 2, 3)
+        assert all(r["moves"] <= 6 and r["failed_moves"] <= r["moves"] for r in runs)
+    assert doc["summary"]["random"]["times_random"] in (1.0, None)
+    assert (tmp_path / "sec_5_6_5_navigation.png").read_bytes()[:4] == b"\x89PNG"

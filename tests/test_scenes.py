@@ -15,7 +15,7 @@ def test_the_table_scene_is_registered():
 
 
 def test_an_unknown_scene_lists_the_known_ones():
-    with pytest.raises(SceneNotFound, match="known scenes: crane-lift, grasp, table"):
+    with pytest.raises(SceneNotFound, match="known scenes: crane-lift, grasp, room, table"):
         get_scene("kitchen")
 
 

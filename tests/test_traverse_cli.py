@@ -13,13 +13,8 @@ TRAVERSE = ("traverse", "traverse-body", "traverse-gaps", "traverse-ramps")
 
 
 @pytest.fixture(scope="module")
-def learned(tmp_path_factory):
-    d = tmp_path_factory.mktemp("traverse")
-    ok(["explore", "--scene", "traverse", "--episodes", "36", "--seed", "5", "--workers", "2", "-o", str(d / "train.afford")])
-    ok(["explore", "--scene", "traverse", "--episodes", "8", "--seed", "6", "-o", str(d / "test.afford")])
-    ok(["select-features", str(d / "train.afford"), "-o", str(d / "features.afford")])
-    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
-    return d
+def learned(traverse_learned):
+    return traverse_learned
 
 
 def test_the_traverse_scenes_are_listed_with_their_moves():

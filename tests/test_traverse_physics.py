@@ -199,15 +199,15 @@ def test_the_room_stays_and_the_robot_moves_and_another_room_differs():
 
 def test_a_wall_ahead_stops_the_robot_and_open_floor_does_not():
     from afford.sim.registry import make_scene
-    from afford.sim.scenes.traverse_room import _in_robot_frame, room_items
+    from afford.sim.scenes.traverse_room import in_robot_frame, room_items
 
     scene = make_scene("traverse-room")
     walls = tuple(it for it in room_items(0) if it.fixed)
     forward = scene.behaviors[0]
     assert forward.name == "go-forward"
     success = list(scene.results).index("success")
-    near_wall = _in_robot_frame(walls, 2.45, 0.0, 0.0)   # the wall's face 50 cm ahead
-    in_the_middle = _in_robot_frame(walls, 0.0, 0.0, 0.0)
+    near_wall = in_robot_frame(walls, 2.45, 0.0, 0.0)   # the wall's face 50 cm ahead
+    in_the_middle = in_robot_frame(walls, 0.0, 0.0, 0.0)
     blocked = forward(scene.build(near_wall, np.random.default_rng(0)), None, np.zeros(0))
     free = forward(scene.build(in_the_middle, np.random.default_rng(0)), None, np.zeros(0))
     assert blocked.result != success and free.result == success

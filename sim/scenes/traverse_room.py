@@ -41,7 +41,7 @@ from afford.sim.objects import SOLID_SHAPES as SHAPES
 from afford.sim.registry import register_scene
 from afford.sim.traverse import Item, TraverseLayout, _rects_overlap, check_layout
 
-__all__ = ["RoomScene", "room_items"]
+__all__ = ["RoomScene", "room_items", "walls", "loose_objects", "in_robot_frame"]
 
 HALF = 3.0           # the room's half width (m)
 WALL = (1.0, 0.10, 0.60)
@@ -54,23 +54,38 @@ _DIMS = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}
 def room_items(room: int) -> tuple[Item, ...]:
     """Room ``room``'s walls and objects, in the room's frame (its centre, metres)."""
     rng = np.random.default_rng(np.random.SeedSequence(entropy=int(room), spawn_key=(3,)))
-    walls = []
+    return walls() + loose_objects(rng, N_OBJECTS)
+
+
+def walls() -> tuple[Item, ...]:
+    """The room's walls: 1 m segments of fixed boxes around its 6 x 6 m floor."""
+    out = []
     for k in range(int(2 * HALF / WALL[0])):
         c = -HALF + WALL[0] * (k + 0.5)
         for x, y, yaw in ((c, HALF, 0.0), (c, -HALF, 0.0), (HALF, c, 90.0), (-HALF, c, 90.0)):
-            walls.append(Item("box", WALL, (round(x, 4), round(y, 4)), yaw, fixed=True))
+            out.append(Item("box", WALL, (round(x, 4), round(y, 4)), yaw, fixed=True))
+    return tuple(out)
+
+
+def loose_objects(rng: np.random.Generator, n: int, taken: tuple = ()) -> tuple[Item, ...]:
+    """``n`` loose objects of 20-40 cm at random places and yaws on the floor, apart from
+    each other, from the walls and from the footprints ``taken``."""
+    wall = tuple(w.footprint() for w in walls())
     objects: list[Item] = []
-    while len(objects) < N_OBJECTS:
+    while len(objects) < n:
         shape = SHAPES[int(rng.integers(len(SHAPES)))]
         size = tuple(round(float(v), 4) for v in rng.uniform(*SIZES, size=_DIMS[shape]))
         pos = tuple(round(float(v), 4) for v in rng.uniform(-HALF + 0.3, HALF - 0.3, size=2))
         it = Item(shape, size, pos, round(float(rng.uniform(0.0, 360.0)), 4))
-        if not any(_rects_overlap(it.footprint(), o.footprint(), 0.05) for o in objects):
+        fp = it.footprint()
+        if any(_rects_overlap(fp, w) for w in wall):
+            continue  # into a wall (it may touch one)
+        if not any(_rects_overlap(fp, o, 0.05) for o in (*taken, *(o.footprint() for o in objects))):
             objects.append(it)
-    return tuple(walls + objects)
+    return tuple(objects)
 
 
-def _in_robot_frame(items: tuple[Item, ...], x: float, y: float, yaw: float) -> TraverseLayout:
+def in_robot_frame(items: tuple[Item, ...], x: float, y: float, yaw: float) -> TraverseLayout:
     c, s = math.cos(math.radians(yaw)), math.sin(math.radians(yaw))
     out = []
     for it in items:
@@ -104,15 +119,24 @@ class RoomScene(TraverseScene):
             raise DataError(f"a room is a seed, 0 or more; got {scene.room}")
         return scene
 
+    def items(self) -> tuple[Item, ...]:
+        """The room's walls and objects in its own frame (its centre)."""
+        return room_items(self.room)
+
     def sample(self, rng: np.random.Generator) -> TraverseLayout:
-        items = room_items(self.room)
+        return self.stand(rng)[0]
+
+    def stand(self, rng: np.random.Generator) -> tuple[TraverseLayout, tuple[float, float, float]]:
+        """The room seen from a random free place: the layout in the robot's frame, and
+        where the robot stands in the room's frame (x, y, yaw)."""
+        items = self.items()
         for _ in range(200):
             x, y = rng.uniform(-HALF + 0.4, HALF - 0.4, size=2)
             yaw = float(rng.uniform(0.0, 360.0))
-            layout = _in_robot_frame(items, float(x), float(y), yaw)
+            layout = in_robot_frame(items, float(x), float(y), yaw)
             try:
                 check_layout(layout, self.config.world.robot)
             except DataError:
                 continue  # on an object, or too near a wall: stand elsewhere
-            return layout
+            return layout, (float(x), float(y), yaw)
         raise DataError(f"room {self.room} has no free place for the robot")  # pragma: no cover - 36 m^2, 30 objects
