@@ -6,6 +6,12 @@ controller (``plan.navigation``) choose, and moves on from wherever the move lef
 move that the robot's own odometry judges failed counts as failed; three failed moves in a
 row, or a whole turn of looking around (six 60-degree turns in place) with nothing to move
 on, and the robot is stuck. The path is the true one (ground truth, for the report only).
+
+The robot also remembers, from its gyro, the headings of the moves that failed since its
+last successful one, and does not try a move that would head within 10 degrees of one of
+them again: a blocked robot has not moved far, sees nearly what it saw, and would otherwise
+be told the same thing by its model and fail the same way until it is stuck. The thesis
+leaves a failed move's aftermath open; this rule is ours (all controllers follow it).
 """
 
 from __future__ import annotations
@@ -23,6 +29,8 @@ STUCK_AFTER = 3
 #: The turn in place (degrees) when nothing is afforded, and how many of them make a whole turn.
 LOOK_TURN = 60.0
 LOOKS = 6
+#: A move heading within this many degrees of a failed one since the last success is not tried.
+REFUSE_WITHIN = 10.0
 
 
 def _success_chances(loaded, x: np.ndarray) -> list[float]:
@@ -68,12 +76,19 @@ def navigate(loaded, scene, controller: str, *, seed: int = 0, steps: int = 100,
         p = robot.pose()
         return round(sx + c * p.x - s * p.y, 4), round(sy + s * p.x + c * p.y, 4)
 
-    path, failed_at, log = [where()], [], []
+    path, failed_at, log, failed_headings = [where()], [], [], []
     distance, moves, failed, in_row, looks, stuck, reason = 0.0, 0, 0, 0, 0, False, None
     for step in range(steps):
         x = world.perceive()
         chances = _success_chances(loaded, x)
-        rotate = choose(controller, [rotations[n] for n in loaded.names], chances, threshold=threshold, rng=pick)
+        heading = math.degrees(robot.gyro())
+        refused = [_near(heading + rotations[n], failed_headings) for n in loaded.names]
+        if all(refused):
+            rotate = None
+        else:
+            names = [n for n, r in zip(loaded.names, refused) if not r]
+            rotate = choose(controller, [rotations[n] for n in names],
+                            [p for p, r in zip(chances, refused) if not r], threshold=threshold, rng=pick)
         if rotate is None:
             world.move(LOOK_TURN, 0.0)
             looks += 1
@@ -89,12 +104,13 @@ def navigate(loaded, scene, controller: str, *, seed: int = 0, steps: int = 100,
         distance += math.hypot(now[0] - before[0], now[1] - before[1])
         path.append(now)
         ok = bool(odometry.success)
-        log.append({"step": step, "rotate": round(float(rotate), 2), "success": ok,
+        log.append({"step": step, "heading": round(heading, 2), "rotate": round(float(rotate), 2), "success": ok,
                     "p_success": round(float(max(chances)), 4)})
         if ok:
-            in_row = 0
+            in_row, failed_headings = 0, []
         else:
             failed, in_row = failed + 1, in_row + 1
+            failed_headings.append(heading + float(rotate))
             failed_at.append(now)
             if in_row >= STUCK_AFTER:
                 stuck, reason = True, f"{STUCK_AFTER} failed moves in a row"
@@ -107,6 +123,11 @@ def navigate(loaded, scene, controller: str, *, seed: int = 0, steps: int = 100,
             "looks": sum(1 for e in log if e.get("look")), "stuck": stuck, "stuck_because": reason,
             "start": [round(sx, 4), round(sy, 4), round(syaw, 2)], "path": [list(p) for p in path],
             "failed_at": [list(p) for p in failed_at], "log": log}
+
+
+def _near(heading: float, headings: list[float]) -> bool:
+    """Whether ``heading`` lies within :data:`REFUSE_WITHIN` degrees of one of ``headings``."""
+    return any(abs((heading - h + 180.0) % 360.0 - 180.0) < REFUSE_WITHIN for h in headings)
 
 
 def _rotation(name: str) -> float:

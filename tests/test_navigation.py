@@ -58,6 +58,12 @@ def test_navigate_drives_the_robot_through_a_room_and_its_successes_are_real_met
         assert all(0.6 < d < 0.8 for d, e in zip(steps, moved) if e["success"])
         assert out["distance_m"] == pytest.approx(float(steps.sum()), abs=0.01)
         assert out["stuck"] == (out["stuck_because"] is not None)
+        # a heading that failed is not tried again before a move succeeds
+        tried = []
+        for e in moved:
+            aim = e["heading"] + e["rotate"]
+            assert all(abs((aim - h + 180) % 360 - 180) >= 10 for h in tried), (aim, tried)
+            tried = [] if e["success"] else tried + [aim]
         assert (tmp_path / f"{controller}.png").read_bytes()[:4] == b"\x89PNG"
     # the same seed, the same run
     again = json.loads(ok(["navigate", str(model), "--controller", "random", "--seed", "2", "--steps", "12", "--json"]).stdout)

@@ -35,7 +35,7 @@ from typing import Callable
 
 import numpy as np
 
-from _common import commit, train_model
+from _common import commit, parser, train_model
 
 
 @dataclass(frozen=True)
@@ -163,6 +163,14 @@ def add_options(ap) -> None:
                     help="training environments (default: 5000 interactions; quick: 100 environments)")
     ap.add_argument("--orientations", default=",".join(str(o) for o in ORIENTATIONS),
                     help="obstacle orientations, degrees (comma-separated)")
+
+
+def main(sweep: Sweep, doc: str) -> None:
+    """The script's command line: options, the sweep, its outputs."""
+    ap = parser(doc)
+    add_options(ap)
+    args = ap.parse_args()
+    write(sweep, run(sweep, args), Path(args.out))
 
 
 def run(sweep: Sweep, args) -> dict:

@@ -8,7 +8,8 @@ The robot learns on ``traverse`` (simple objects, 5.6.1) as ``afford explore | s
 navigate`` in K rooms of the ``room`` scene (seeds 0..K-1: walls, tables and chairs it never
 met, loose objects), once per controller: aggressive and cautious (Figure 5.9) and random
 (the baseline). A run ends after N steps or when the robot is stuck (three failed moves in a
-row, or a whole turn of looking around with nothing afforded). The thesis shows paths
+row, or a whole turn of looking around with nothing afforded; after a failed move the robot
+does not try a heading that failed since its last success). The thesis shows paths
 (Figures 5.10, 5.11) and argues that the cautious controller risks fewer collisions; it
 gives no numbers.
 
@@ -74,7 +75,7 @@ def write(doc: dict, runs: list[dict], out: Path) -> None:
         lines.append(f"| {c} | {s[c]['mean_distance_m']:.2f} m | {times} | {fpm} | {s[c]['stuck']} of {s[c]['runs']} |")
     lines += ["", "The thesis gives paths, not numbers: it argues the cautious controller risks fewer collisions "
               "than the aggressive one. A run ends stuck after three failed moves in a row (or a whole turn with "
-              "nothing afforded)."]
+              "nothing afforded); a heading that failed is not tried again before a move succeeds."]
     (out / f"{NAME}.md").write_text("\n".join(lines) + "\n")
     _figure(runs, out / f"{NAME}.png")
 

@@ -24,8 +24,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import parser  # noqa: E402
-from _critical import Sweep, add_options, run, write  # noqa: E402
+from _critical import Sweep, main  # noqa: E402
 
 #: Table 5.1 as printed: predicted / actual critical angle per orientation, in its three
 #: columns. The column icons are lost in our copy of the text; we set them beside ours in
@@ -53,12 +52,5 @@ SWEEP = Sweep(
             "predictions above 30 degrees extrapolate."))
 
 
-def main() -> None:
-    ap = parser(__doc__)
-    add_options(ap)
-    args = ap.parse_args()
-    write(SWEEP, run(SWEEP, args), Path(args.out))
-
-
 if __name__ == "__main__":
-    main()
+    main(SWEEP, __doc__)

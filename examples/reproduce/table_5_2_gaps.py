@@ -24,8 +24,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import parser  # noqa: E402
-from _critical import Sweep, add_options, run, write  # noqa: E402
+from _critical import Sweep, main  # noqa: E402
 
 #: Table 5.2 as printed: predicted / actual critical width (cm) per orientation, in its
 #: three columns. The icons are lost in our copy; the first differs from the other two and
@@ -52,12 +51,5 @@ SWEEP = Sweep(
             "Exploration drew gaps of 5-50 cm, so predictions above 50 cm extrapolate."))
 
 
-def main() -> None:
-    ap = parser(__doc__)
-    add_options(ap)
-    args = ap.parse_args()
-    write(SWEEP, run(SWEEP, args), Path(args.out))
-
-
 if __name__ == "__main__":
-    main()
+    main(SWEEP, __doc__)
