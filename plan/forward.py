@@ -276,6 +276,7 @@ class ForwardModel:
 
     def distribution(self, f: np.ndarray, b: int, alpha: tuple = ()) -> tuple[np.ndarray, np.ndarray]:
         """(categories, probabilities) of behaviour ``b`` on entity vector ``f``."""
+        alpha = () if alpha is None else alpha
         key = (b, f.tobytes(), alpha)
         if key not in self._cache:
             self.prefetch([f], b, alpha)
@@ -467,8 +468,10 @@ class ForwardModel:
         return nxt
 
     def outcomes(self, state: np.ndarray, obj: int, b: int, alpha: tuple = (), floor: float | None = None) -> list[Outcome]:
-        """Likely outcomes (probability >= ``floor``, by default min_probability), most likely first."""
+        """Likely outcomes (probability >= ``floor``, by default min_probability), most likely
+        first. ``alpha``: the behaviour's parameters; ``()`` or ``None`` for none."""
         floor = self.min_probability if floor is None else floor
+        alpha = () if alpha is None else alpha
         if obj == SCENE:
             return self._scene_outcomes(state, b, alpha, floor)
         if not self.visible(state[obj]):
