@@ -229,15 +229,15 @@ def test_unknown_effects_lower_the_probabilities_plans_count_on():
     assert [s.behavior for s in plan.steps] == ["sweep"]
 
 
+PUSH_HALF = behaviour("push", [(0.6, effect(0.2)), (0.4, effect())])
+SLIDE = behaviour("slide", [(0.5, effect(0.2)), (0.5, effect())])
+
+
 def test_no_parameters_may_be_said_as_none():
     fm = ForwardModel([PUSH_HALF], SCHEMA)
     by_none = fm.outcomes(scene(0.0), 0, 0, None)
     assert [(o.category, o.probability) for o in by_none] == [(o.category, o.probability) for o in fm.outcomes(scene(0.0), 0, 0)]
     assert len(by_none) == 2 and by_none[0].probability == pytest.approx(0.6)
-
-
-PUSH_HALF = behaviour("push", [(0.6, effect(0.2)), (0.4, effect())])
-SLIDE = behaviour("slide", [(0.5, effect(0.2)), (0.5, effect())])
 
 
 def test_reach_probability_imagines_monitored_execution():
