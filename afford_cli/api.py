@@ -113,37 +113,15 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int | N
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
     from afford.learn.affordances import discover_effects
-    from afford.learning import effects_members
+    from afford.learning import clustering_settings, effects_members
 
     check_output(output)
     art, data = read_rows(path)
     if not data.has_after:
         raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
                           f"its labels are given ({'/'.join(data.result_names)}): run select-features or train on it directly")
-    own = data.scene.get("clustering") or {}
-    if method is None:  # the scene's own clustering; a k given here overrides its k
-        method = own.get("method", "hierarchical")
-        if own.get("k"):
-            k = {**own["k"], **({} if k is None else k if isinstance(k, dict) else {"*": k})}
-    if channels is None and method == "hierarchical":
-        channels = own.get("channels")
-        if channels is not None and (not isinstance(channels, list) or not all(isinstance(c, str) for c in channels)):
-            raise AffordError(f"{art.source}: its scene's clustering channels must be a list of channel names")
-    if k_max is None:
-        k_max = own.get("k_max", 5)
-        if not isinstance(k_max, int) or isinstance(k_max, bool) or not 1 <= k_max <= 20:
-            raise AffordError(f"{art.source}: its scene's clustering k_max must be a whole number 1-20, got {k_max!r}")
-    if channels is not None:
-        channels = [channels] if isinstance(channels, str) else [str(c) for c in channels]
-        known = list(dict.fromkeys(data.schema.channels))
-        unknown = [c for c in channels if c not in known]
-        if unknown or not channels:
-            raise AffordError(f"no effect channel {', '.join(map(repr, unknown)) or 'given'} in {art.source}; "
-                              f"its channels are {', '.join(known)}")
-        if method != "hierarchical":
-            raise AffordError("--channels goes with the hierarchical method (k-means clusters every channel at once)")
-    if k is not None and method != "kmeans":
-        raise AffordError("a k goes with the k-means method (--method kmeans)")
+    own = clustering_settings(data.scene, data.schema, art.source, method=method, k=k, channels=channels, k_max=k_max)
+    method, k, channels, k_max = own["method"], own["k"], own["channels"], own["k_max"]
     start = time.perf_counter()
     models, labels = discover_effects(data, method=method, k_max=k_max, k=k, prune=prune, min_fraction=min_fraction,
                                       seed=seed, channels=channels, progress=_per_behaviour(progress, data))

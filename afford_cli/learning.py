@@ -145,6 +145,40 @@ def _feature_indices(art: Artifact, member: str, d: int) -> np.ndarray:
 _MANIFEST_OWN = {"format", "kind", "schema_version", "afford_version", "created", "command", "seed", "parents", "members"}
 
 
+def clustering_settings(scene: dict, schema, source: str, *, method: str | None = None, k: int | dict | None = None,
+                        channels: list[str] | str | None = None, k_max: int | None = None) -> dict:
+    """How to discover the effect categories of a scene so described (``scene``, its
+    ``describe()``; ``schema``, its perception): the options given, else the scene's own
+    (``clustering`` in its description), else the hierarchical method with every channel
+    and ``k_max`` 5; checked, each mistake one sentence naming ``source``. Returns
+    ``{"method", "k", "channels", "k_max"}``."""
+    own = scene.get("clustering") or {}
+    if method is None:  # the scene's own clustering; a k given here overrides its k
+        method = own.get("method", "hierarchical")
+        if own.get("k"):
+            k = {**own["k"], **({} if k is None else k if isinstance(k, dict) else {"*": k})}
+    if channels is None and method == "hierarchical":
+        channels = own.get("channels")
+        if channels is not None and (not isinstance(channels, list) or not all(isinstance(c, str) for c in channels)):
+            raise AffordError(f"{source}: its scene's clustering channels must be a list of channel names")
+    if k_max is None:
+        k_max = own.get("k_max", 5)
+        if not isinstance(k_max, int) or isinstance(k_max, bool) or not 1 <= k_max <= 20:
+            raise AffordError(f"{source}: its scene's clustering k_max must be a whole number 1-20, got {k_max!r}")
+    if channels is not None:
+        channels = [channels] if isinstance(channels, str) else [str(c) for c in channels]
+        known = list(dict.fromkeys(schema.channels))
+        unknown = [c for c in channels if c not in known]
+        if unknown or not channels:
+            raise AffordError(f"no effect channel {', '.join(map(repr, unknown)) or 'given'} in {source}; "
+                              f"its channels are {', '.join(known)}")
+        if method != "hierarchical":
+            raise AffordError("--channels goes with the hierarchical method (k-means clusters every channel at once)")
+    if k is not None and method != "kmeans":
+        raise AffordError("a k goes with the k-means method (--method kmeans)")
+    return {"method": method, "k": k, "channels": channels, "k_max": k_max}
+
+
 def _scene_learner(data: Interactions) -> dict:
     """The scene's learner settings (``learner`` in its configuration), or none."""
     learner = data.scene.get("learner")

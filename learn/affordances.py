@@ -93,21 +93,30 @@ def discover_effects(data: Interactions, *, method: str = "hierarchical", k_max:
     """
     labels = np.full(len(data), -1, dtype=np.int16)
     models = {}
-    effects = data.effects
     ks = k_per_behaviour(k, data.behavior_names)
     for b, name in enumerate(data.behavior_names):
         rows = behaviour_rows(data, b)
         _check_rows(data, b, rows, "clustering")
         X = predictor_inputs(data.before_rows(rows), data.params[rows], np.arange(len(data.schema)), parameters_of(data, b))
-        ec = EffectCategories(schema=tuple(data.schema.channels), method=method, k_max=k_max, k=ks[name], prune=prune,
-                              min_fraction=min_fraction, channels=None if channels is None else tuple(channels),
-                              random_state=behaviour_seed(seed, b))
-        ec.fit(effects[rows], X)
+        ec = effect_categories(data.schema, data.effects_of(rows), X, b, method=method, k_max=k_max, k=ks[name],
+                               prune=prune, min_fraction=min_fraction, seed=seed, channels=channels)
         labels[rows] = ec.labels_
         models[name] = ec
         if progress is not None:
             progress(b + 1)
     return models, labels
+
+
+def effect_categories(schema, E: np.ndarray, X: np.ndarray, b: int, *, method: str = "hierarchical", k_max: int = 5,
+                      k: int | None = None, prune: str = "frequency", min_fraction: float = 0.03, seed: int = 0,
+                      channels: list[str] | None = None) -> EffectCategories:
+    """Behaviour ``b``'s effect categories, found in the effects ``E`` of some of its rows
+    (all of them, or a curious robot's bootstrap) whose predictor inputs are ``X``; ``k``
+    is its own k-means k (None: X-means' choice)."""
+    ec = EffectCategories(schema=tuple(schema.channels), method=method, k_max=k_max, k=k, prune=prune,
+                          min_fraction=min_fraction, channels=None if channels is None else tuple(channels),
+                          random_state=behaviour_seed(seed, b))
+    return ec.fit(E, X)
 
 
 def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "relieff", top: int | None = None,

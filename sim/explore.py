@@ -89,8 +89,10 @@ def run_episode(scene, seed: int, episode: int, max_steps: int | None = None) ->
     return run_play_episode(scene, seed, episode, scene.config.max_steps if max_steps is None else max_steps)
 
 
-def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Interactions:
-    """One trial of Algorithm 5 in a fresh world; returns its rows."""
+def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10, only: int | None = None) -> Interactions:
+    """One trial of Algorithm 5 in a fresh world; returns its rows. ``only``: run behaviour
+    ``only`` once, its parameters from the trial's own generator (a curious robot trying
+    candidate ``episode``), instead of random behaviours."""
     rng = episode_rng(seed, episode)
     specs = scene.sample(rng)
     spec = specs[0]
@@ -108,10 +110,11 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
     f = world.perceive()
     looks = [f[0]] if f.shape[0] else []
     steps = 0
-    while f.shape[0] and schema.visible(f[0]) and steps < max_steps:
-        b = int(rng.integers(len(behaviors)))
+    while f.shape[0] and schema.visible(f[0]) and steps < (1 if only is not None else max_steps):
+        b = int(rng.integers(len(behaviors))) if only is None else only
         behavior = behaviors[b]
-        alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
+        draw = rng if only is None else _try_rng(seed, episode, only)
+        alpha = np.array([draw.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
         step = interact(world, behavior, 0, alpha, before=f)
         f1 = step.after
         t0, t1 = step.truth_before[0], step.truth_after[0]
@@ -163,9 +166,10 @@ def run_play_episode(scene, seed: int, episode: int, max_steps: int = 10) -> Int
     )
 
 
-def run_scan_episode(scene, seed: int, episode: int) -> Interactions:
+def run_scan_episode(scene, seed: int, episode: int, only: int | None = None) -> Interactions:
     """One trial of Algorithm 1: a random environment, scanned once, every behaviour tried
-    from the same start in a freshly built world.
+    from the same start in a freshly built world (``only``: behaviour ``only`` alone, its
+    parameters from the trial's own generator: a curious robot trying candidate ``episode``).
 
     With given labels (chapter 5) the label is the robot's own reading and nothing is
     perceived after. With discovered labels (chapter 7) the robot looks again after each
@@ -176,11 +180,13 @@ def run_scan_episode(scene, seed: int, episode: int) -> Interactions:
     first = scene.build(layout, rng)
     entity = np.asarray(first.perceive(), dtype=np.float32)
     discovered = scene.labels == "discovered"
-    behaviors = scene.behaviors if not discovered or entity.shape[0] else ()
+    behaviors = scene.behaviors if only is None else scene.behaviors[only:only + 1]
+    behaviors = behaviors if not discovered or entity.shape[0] else ()
     n_params = max((len(b.parameters) for b in scene.behaviors), default=0)
     params, results, truth, after = [], [], [], []
+    draw = rng if only is None else _try_rng(seed, episode, only)
     for behavior in behaviors:
-        alpha = np.array([rng.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
+        alpha = np.array([draw.uniform(p.low, p.high) for p in behavior.parameters], dtype=float)
         world = scene.build(layout, rng)
         if discovered:
             world.resume(first)
@@ -399,11 +405,29 @@ def _try_rng(seed: int, candidate: int, behavior: int) -> np.random.Generator:
 
 
 def scan_candidate(scene, seed: int, candidate: int) -> np.ndarray:
-    """Candidate ``candidate`` of a scan scene's stream: a random environment, scanned once;
-    its entity (d,), the same as Algorithm 1's episode of that number perceives."""
+    """Candidate ``candidate`` of a scene's stream, looked at once (no physics): its entity
+    (d,), what the scene's episode of that number perceives first. In a scene whose
+    results are given, the environment's scan; in one that discovers its categories, the
+    first object seen (all NaN when none is seen: no situation to learn from)."""
     rng = episode_rng(seed, candidate)
     layout = scene.sample(rng)
-    return np.asarray(scene.build(layout, rng).perceive(), dtype=np.float32)[0]
+    seen = np.asarray(scene.build(layout, rng).perceive(), dtype=np.float32)
+    if scene.labels == "given":
+        return seen[0]
+    if seen.shape[0] and scene.schema.visible(seen[0]):
+        return seen[0]
+    return np.full(len(scene.schema), np.nan, dtype=np.float32)
+
+
+def try_candidate_effect(scene, seed: int, candidate: int, behavior: int) -> Interactions:
+    """Run behaviour ``behavior`` on candidate ``candidate``'s object (a scene that
+    discovers its categories), from the start its episode perceives (the same look as
+    :func:`scan_candidate`): one row of interactions with its effect and ground truth (none
+    when nothing is seen). Every (candidate, behaviour) draws its parameters from its own
+    generator, so the row does not depend on what else was tried."""
+    if scene.loop == "scan":
+        return run_scan_episode(scene, seed, candidate, only=behavior)
+    return run_play_episode(scene, seed, candidate, only=behavior)
 
 
 def try_candidate(scene, seed: int, candidate: int, behavior: int) -> tuple[int, np.ndarray, dict]:
@@ -427,9 +451,8 @@ def _scan_chunk(scene, seed: int, candidates: list[int], in_worker: bool = False
 
 def scan_candidates(scene, n: int, *, seed: int = 0, pool=None, workers: int = 1,
                     progress: Callable[[int, int], None] | None = None) -> np.ndarray:
-    """The entities (n, d) of candidates 0 .. n-1, scanned on ``pool`` (any order, put back in order)."""
-    if scene.loop != "scan":
-        raise DataError(f"scene {scene.name!r} plays with objects; candidates are the scan scenes' environments")
+    """The entities (n, d) of candidates 0 .. n-1 (:func:`scan_candidate`), looked at on
+    ``pool`` (any order, put back in order)."""
     out: dict[int, np.ndarray] = {}
     own = pool is None
     pool = LocalPool(workers) if own else pool

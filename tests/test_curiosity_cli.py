@@ -78,10 +78,55 @@ def test_a_candidate_is_the_environment_algorithm_1_would_explore_and_workers_do
 
 def test_curiosity_options_are_checked(tmp_path):
     out = str(tmp_path / "x.afford")
-    r = runner.invoke(app, ["explore", "--strategy", "margin", "--candidates", "10", "-o", out])
-    assert r.exit_code == 1 and "needs a scene whose results are given" in r.output
+    r = runner.invoke(app, ["explore", "--scene", "grasp", "--strategy", "entropy", "--candidates", "10", "-o", out])
+    assert r.exit_code == 1 and "behaviours with parameters is not built" in r.output
+    r = runner.invoke(app, ["explore", "--strategy", "entropy", "--candidates", "30", "--bootstrap", "5", "-o", out])
+    assert r.exit_code == 1 and "--bootstrap must be between 10 and the 30 candidates" in r.output
+    r = runner.invoke(app, ["explore", "--strategy", "entropy", "--max-steps", "3", "-o", out])
+    assert r.exit_code == 2 and "--max-steps does not go with --strategy" in " ".join(r.output.replace("│", " ").split())
     r = runner.invoke(app, ["explore", "--tau", "0.2", "-o", out])
     assert r.exit_code == 2 and "--tau goes with --strategy" in " ".join(r.output.replace("│", " ").split())
     r = runner.invoke(app, ["explore", "--scene", "traverse", "--strategy", "margin", "--episodes", "5", "-o", out])
     assert r.exit_code == 2 and "--episodes does not go with --strategy" in " ".join(r.output.replace("│", " ").split())
     assert not list(tmp_path.iterdir())
+
+
+@pytest.fixture(scope="module")
+def curious_table(tmp_path_factory):
+    d = tmp_path_factory.mktemp("curious-table")
+    ok(["explore", "--episodes", "20", "--seed", "61", "--workers", "2", "-o", str(d / "test.afford")])
+    out = json.loads(ok(["explore", "--strategy", "entropy", "--candidates", "80", "--bootstrap", "30", "--seed", "5",
+                         "--workers", "2", "--test", str(d / "test.afford"), "-o", str(d / "cur.afford"),
+                         "--json"]).stdout)
+    return d, out
+
+
+def test_at_the_table_it_is_curious_about_the_effect_categories_it_discovered(curious_table):
+    import afford
+    from afford.sim.explore import scan_candidate
+
+    d, out = curious_table
+    with zipfile.ZipFile(d / "cur.afford") as z:
+        tried = np.load(io.BytesIO(z.read("online_tried.npy")), allow_pickle=False)
+    data = afford.load_interactions(str(d / "cur.afford"))
+    scene = afford.make_scene("table")
+    assert tried.shape == (80, 4) and out["with_object"] <= 80
+    assert len(data) == int(tried.sum()) < 80 * 4  # the bootstrap, then only what interested it
+    for b, name in enumerate(data.behavior_names):
+        rows = np.flatnonzero(data.behavior == b)
+        assert sorted(data.episode[rows].tolist()) == np.flatnonzero(tried[:, b]).tolist()
+        assert tried[:, b].sum() >= 30 and out["behaviors"][name]["n_categories"] >= 2
+    # a row starts from what the candidate looked like, and its effect is what PhysX did:
+    # a lift that lifted raised the object's perceived top, a push moved it or left it
+    for r in (0, len(data) // 2, len(data) - 1):
+        assert np.array_equal(data.before[r], scan_candidate(scene, 5, int(data.episode[r])))
+    top = data.effects[:, data.schema.names.index("z_max")]
+    lifted = (data.behavior == 3) & (data.truth["outcome"] == data.outcome_names.index("lifted"))
+    still = data.truth["outcome"] == data.outcome_names.index("no-change")
+    assert lifted.sum() >= 3 and np.median(top[lifted]) > 0.15 and np.median(np.abs(top[still])) < 0.02
+    curve = out["curve"]
+    assert {c["behavior"] for c in curve} == set(data.behavior_names)
+    assert all(0 <= c["accuracy"] <= 1 and c["interactions"] >= 30 for c in curve)
+    # the artefact is ordinary interactions: the table's pipeline takes it
+    ok(["cluster", str(d / "cur.afford"), "-o", str(d / "e.afford")])
+    ok(["train", str(d / "e.afford"), "-o", str(d / "m.afford")])

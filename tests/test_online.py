@@ -70,3 +70,47 @@ def test_bad_settings_are_one_sentence():
         learn_online(X, y, "greedy")
     with pytest.raises(DataError, match="bootstrap needs between 2 and 50"):
         learn_online(X, y, bootstrap=60)
+
+
+def planted_effects(seed: int, n: int):
+    """Candidates whose effect (2 numbers) falls in one of three places, decided by 2 of 12
+    features; the learner is told only the effects, and discovers the categories."""
+    rng = np.random.default_rng(seed)
+    X = rng.uniform(0, 1, (n, 12))
+    category = np.where(X[:, 0] < 0.35, 0, np.where(X[:, 1] < 0.5, 1, 2))
+    E = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])[category] + rng.normal(0, 0.05, (n, 2))
+    return X, E, category
+
+
+def kmeans_categorise(calls: list):
+    from sklearn.cluster import KMeans
+
+    def categorise(outcomes, rows):
+        calls.append(list(rows))
+        km = KMeans(3, n_init=10, random_state=0).fit(np.stack(outcomes))
+        return lambda E: km.predict(np.asarray(E, dtype=float).reshape(len(E), -1))
+
+    return categorise
+
+
+def test_curiosity_over_discovered_categories_beats_random_at_equal_interactions():
+    Xt, Et, truth = planted_effects(98, 800)
+    gain: dict[str, list] = {"entropy": [], "committee": [], "margin": []}
+    for order in range(3):
+        X, E, _ = planted_effects(order, 700)
+        calls: list = []
+        acc = {}
+        for strategy, budget in (("random", None), ("entropy", 150), ("committee", None), ("margin", None)):
+            run = learn_online(X, E, strategy, bootstrap=25, budget=budget, categorise=kmeans_categorise(calls),
+                               X_test=Xt, y_test=list(Et), every=5, seed=order)
+            acc[strategy] = [c for c in run.curve if c["interactions"] <= 150][-1]["accuracy"]
+            if strategy == "random":
+                # what was discovered is the planted structure: each place's effects share a category
+                found = run.encode(list(Et))
+                assert min(np.mean(found[truth == c] == np.bincount(found[truth == c]).argmax()) for c in range(3)) > 0.95
+                assert np.unique(found).size == 3
+        # the categories are found once per run, from the bootstrap's effects alone
+        assert calls == [list(range(25))] * 4
+        for s in gain:
+            gain[s].append(acc[s] - acc["random"])
+    assert all(np.median(g) > 0 for g in gain.values()), gain

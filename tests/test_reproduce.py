@@ -50,6 +50,27 @@ def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_pat
     assert (tmp_path / "fig_6_5_6_6_curiosity.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_table_curiosity_replays_one_stream_for_every_strategy_and_both_labellings(tmp_path):
+    script = SCRIPTS / "sec_6_curiosity_table.py"
+    subprocess.run([sys.executable, str(script), "--quick", "--candidates", "130", "--test-size", "60", "--orderings", "2",
+                    "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    doc = json.loads((tmp_path / "sec_6_curiosity_table.json").read_text())
+    assert doc["seed"] == 1 and doc["quick"] and doc["commit"] and doc["budget"] == max(doc["candidates"] // 3, 70)
+    rows = doc["rows"]
+    assert {r["labels"] for r in rows} == {"discovered", "outcome"}
+    assert {r["behavior"] for r in rows} == {"push-forward", "push-left", "push-right", "lift"}
+    ends = {(r["labels"], r["behavior"], r["strategy"]): r for r in rows if r["interactions"] == "end"}
+    for (labels, behavior, strategy), r in ends.items():
+        assert r["thesis"] is None and 0 <= r["q1"] <= r["median"] <= r["q3"] <= 1
+        if strategy == "random":  # random tries every candidate; the entropy budget caps what it tries
+            assert r["tried"] == doc["candidates"]
+        if strategy == "entropy-budget":
+            assert 50 <= r["tried"] <= doc["budget"]
+    assert all(len(k) >= 1 and min(k) >= 1 for k in doc["n_categories"].values())
+    assert "Diagnosis" in (tmp_path / "sec_6_curiosity_table.md").read_text()
+    assert (tmp_path / "sec_6_curiosity_table.png").read_bytes()[:4] == b"\x89PNG"
+
+
 def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     script = SCRIPTS / "table_7_1_crane.py"
     subprocess.run([sys.executable, str(script), "--quick", "--train", "150", "--test", "50", "--placements", "10",

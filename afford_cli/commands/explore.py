@@ -32,7 +32,7 @@ class Strategy(str, Enum):
 
 def explore_online_command(output: str, scene: str, strategy: str, *, seed: int, workers: int, grid, layers, room, tau: float,
                            bootstrap: int, candidates: int, threshold: float, budget, test, plots, json: bool,
-                           others: dict) -> None:
+                           size_min=None, size_max=None, others: dict) -> None:
     """``explore --strategy``: curiosity-driven exploration (:mod:`afford.curiosity`)."""
     from afford.artifacts import artifact_bytes, write_artifact
     from afford.curiosity import explore_online, online_members
@@ -40,12 +40,12 @@ def explore_online_command(output: str, scene: str, strategy: str, *, seed: int,
 
     given = [k for k, v in others.items() if v is not None]
     if given:
-        raise typer.BadParameter(f"{given[0]} does not go with --strategy: a curiosity-driven exploration runs "
-                                 "--candidates environments once, on this machine")
+        raise typer.BadParameter(f"{given[0]} does not go with --strategy: a curiosity-driven exploration tries "
+                                 "--candidates situations once each, on this machine")
     check_output(output)
     plot_dir = plot_directory(plots) if plots is not None else None
     out = Output(json, stdout_busy=writes_stdout(output))
-    sc = make_scene(scene, grid=grid, layers=layers, room=room)
+    sc = make_scene(scene, grid=grid, layers=layers, room=room, size_min=size_min, size_max=size_max)
     test_data = read_rows(test, ("interactions",))[1] if test is not None else None
     start = time.perf_counter()
     with out.progress(f"curious about {sc.name}", candidates, lazy=True) as update:
@@ -64,7 +64,7 @@ def explore_online_command(output: str, scene: str, strategy: str, *, seed: int,
         result["plots"] = [curve_figure(plot_dir / "learning-curve.png", report["curve"], strategy)]
 
     def render(console):
-        console.print(f"[bold]curious[/] ({strategy}): of {candidates} scanned environments, tried per behaviour: "
+        console.print(f"[bold]curious[/] ({strategy}): of {candidates} candidates, tried per behaviour: "
                       + ", ".join(f"{n} {b['tried']}" for n, b in report["behaviors"].items())
                       + f"; {len(data)} interactions -> {output}")
         if "curve" in report:
@@ -156,11 +156,11 @@ def explore(
     resume: Annotated[bool, typer.Option("--resume", help="Continue the interrupted run whose finished episodes are journaled in OUTPUT.partial/ (same options); starts afresh if there is none.")] = False,
     episode_start: Annotated[Optional[int], typer.Option("--episode-start", min=0, help="First episode of this shard of a larger exploration (with --episode-count; join shards with 'afford merge').")] = None,
     episode_count: Annotated[Optional[int], typer.Option("--episode-count", min=1, help="Episodes in this shard, from --episode-start (0 by default).")] = None,
-    strategy: Annotated[Optional[Strategy], typer.Option("--strategy", help="Curiosity-driven exploration (thesis chapter 6, scenes whose results are given): scan --candidates environments and act only where the learner finds them interesting: random (all), margin (the thesis: SVM output within --tau), entropy (calibrated probabilities, --threshold bits or --budget), committee (a bootstrap ensemble disagrees).")] = None,
+    strategy: Annotated[Optional[Strategy], typer.Option("--strategy", help="Curiosity-driven exploration (thesis chapter 6; scenes whose results are given, or whose effect categories are discovered from the bootstrap, as at the table): look at --candidates situations and act only where the learner finds them interesting: random (all), margin (the thesis: SVM output within --tau), entropy (calibrated probabilities, --threshold or --budget), committee (a bootstrap ensemble disagrees).")] = None,
     tau: Annotated[float, typer.Option("--tau", min=0.0, help="margin: try a candidate whose SVM output lies within this of the boundary (the thesis's 0.5).")] = 0.5,
-    bootstrap: Annotated[int, typer.Option("--bootstrap", min=2, help="Candidates tried first, all of them, to choose the features (ReliefF, once) and fit the first SVM (the thesis's 25).")] = 25,
-    candidates: Annotated[int, typer.Option("--candidates", min=2, help="Candidate environments in the stream (the thesis's 3000).")] = 3000,
-    threshold: Annotated[float, typer.Option("--threshold", min=0.0, max=1.0, help="entropy: try a candidate whose predicted result has at least this entropy, in bits.")] = 0.7,
+    bootstrap: Annotated[int, typer.Option("--bootstrap", min=2, help="Candidates tried first, all of them, to choose the features (ReliefF, once), discover the effect categories (scenes that discover them; at least 10) and fit the first SVM (the thesis's 25).")] = 25,
+    candidates: Annotated[int, typer.Option("--candidates", min=2, help="Candidate situations in the stream: environments, or objects on the table (the thesis's 3000).")] = 3000,
+    threshold: Annotated[float, typer.Option("--threshold", min=0.0, max=1.0, help="entropy: try a candidate whose predicted result or category has at least this entropy, in units of its largest (bits for two results).")] = 0.7,
     budget: Annotated[Optional[int], typer.Option("--budget", min=1, help="entropy: try about this many candidates per behaviour, the most uncertain (instead of --threshold).")] = None,
     test: Annotated[Optional[str], typer.Option("--test", metavar="DATA", help="Interactions of the same scene to score the learner on as it goes: --json holds the learning curve.")] = None,
     plots: PlotDir = None,
@@ -174,8 +174,9 @@ def explore(
     if strategy is not None:
         return explore_online_command(output, scene, strategy.value, seed=seed, workers=workers, grid=grid, layers=layers, room=room,
                                       tau=tau, bootstrap=bootstrap, candidates=candidates, threshold=threshold,
-                                      budget=budget, test=test, plots=plots, json=json,
+                                      budget=budget, test=test, plots=plots, json=json, size_min=size_min, size_max=size_max,
                                       others={"--episodes": episodes, "--interactions": interactions,
+                                              "--max-steps": max_steps,
                                               "--resume": resume or None, "--episode-start": episode_start,
                                               "--episode-count": episode_count, "--scheduler": scheduler,
                                               "--backend": None if backend is Backend.loky else backend.value})
