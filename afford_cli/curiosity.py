@@ -18,9 +18,10 @@ those categories: the curiosity is over calibrated probabilities of effect categ
 workers; the rows are the same for any number of them.
 
 The interactions written hold every tried (candidate, behaviour) as a row with its given
-result, so ``select-features``, ``train`` and ``evaluate`` take them as they take
-Algorithm 1's; the manifest's ``online`` says how they were chosen, and the member
-``online_tried`` (candidates x behaviours) which were tried and which skipped.
+result (or its effect), so ``select-features``, ``train`` and ``evaluate`` (or
+``cluster`` first) take them as they take the scene's own loop's; the manifest's
+``online`` says how they were chosen, and the member ``online_tried`` (candidates x
+behaviours) which were tried and which skipped.
 """
 
 from __future__ import annotations
@@ -135,8 +136,9 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
                           f"object, fewer than the bootstrap of {bootstrap}; draw more --candidates")
     settings = {"bootstrap": bootstrap, "tau": tau, "threshold": threshold, "budget": budget,
                 "n_features": n_features, "every": every}
-    learner = scene.describe().get("learner")
-    kernel = str((learner if isinstance(learner, dict) else {}).get("kernel", "rbf"))
+    from afford.learning import learner_settings
+
+    kernel, _ = learner_settings(None, scene.describe())
     B = len(scene.behaviors)
 
     def test_of(b):
@@ -145,6 +147,9 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
         rows = np.flatnonzero(test.behavior == b)
         if discovered:  # the situations candidates are: a fresh start, nothing in hand yet
             rows = rows[test.step[rows] == 0]
+            if rows.size == 0:
+                raise AffordError(f"the test interactions have no first step of behaviour {names[b]!r} to score it "
+                                  "on; explore more episodes for the test")
             return test.before_rows(rows), test.effects_of(rows)
         return test.before_rows(rows), test.result[rows].astype(int)
 
@@ -168,14 +173,16 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
     pairs = sorted((i, b) for b in range(B) for i in learned[b][3])
     data = _tried_rows(scene, X, pairs, learned) if discovered else _given_rows(scene, X, pairs, learned)
     tried = np.stack([learned[b][0] for b in range(B)], axis=1)
+    situations = int(np.isfinite(X).all(axis=1).sum())  # candidates with something to act on
     report = {
         "strategy": strategy, "candidates": candidates, **settings, "kernel": kernel,
-        "behaviors": {names[b]: {"tried": int(tried[:, b].sum()), "skipped": int(candidates - tried[:, b].sum()),
+        "behaviors": {names[b]: {"tried": int(tried[:, b].sum()), "skipped": int(situations - tried[:, b].sum()),
                                  "n_selected": int(len(learned[b][1])),
                                  **({"n_categories": learned[b][4]} if discovered else {})} for b in range(B)},
     }
     if discovered:
-        report["with_object"] = int(np.isfinite(X).all(axis=1).sum())
+        report["with_object"] = situations
+        report["clustering"] = clustering
     if test is not None:
         report["curve"] = [{"behavior": names[b], **c} for b in range(B) for c in learned[b][2]]
     return data, tried, report
@@ -209,8 +216,6 @@ def _tried_rows(scene, X: np.ndarray, pairs: list[tuple[int, int]], learned: dic
     then each row's look after."""
     from afford.features import Interactions
 
-    if not pairs:
-        raise AffordError("nothing was tried")  # the bootstrap always is: not reached
     rows = Interactions.concatenate([learned[b][3][i] for i, b in pairs])
     looked = sorted({i for i, _ in pairs})
     at = {c: k for k, c in enumerate(looked)}

@@ -179,17 +179,18 @@ def clustering_settings(scene: dict, schema, source: str, *, method: str | None 
     return {"method": method, "k": k, "channels": channels, "k_max": k_max}
 
 
-def _scene_learner(data: Interactions) -> dict:
-    """The scene's learner settings (``learner`` in its configuration), or none."""
-    learner = data.scene.get("learner")
+def _scene_learner(scene: dict) -> dict:
+    """The scene's learner settings (``learner`` in its description), or none."""
+    learner = scene.get("learner")
     return learner if isinstance(learner, dict) else {}
 
 
-def learner_settings(art: Artifact | None, data: Interactions, kernel: str | None = None,
+def learner_settings(art: Artifact | None, data: Interactions | dict, kernel: str | None = None,
                      folds: int | None = None) -> tuple[str, int]:
-    """The kernel and folds to learn with: those given, else the scene's (``learner`` in its
-    configuration), else the RBF kernel and 3 folds."""
-    learner = _scene_learner(data)
+    """The kernel and folds to learn ``data`` with (interactions, or a scene's description):
+    those given, else the scene's (``learner`` in its configuration), else the RBF kernel
+    and 3 folds."""
+    learner = _scene_learner(data if isinstance(data, dict) else data.scene)
     kernel = kernel if kernel is not None else str(learner.get("kernel", "rbf"))
     if kernel not in ("rbf", "linear"):
         raise AffordError(f"{art.source if art else 'the data'} asks for an unknown kernel {kernel!r}; give --kernel")
@@ -207,7 +208,7 @@ SCORES = ("accuracy", "log_loss")
 def selection_score(art: Artifact | None, data: Interactions, score: str | None = None) -> str:
     """What ReliefF's ranking cut scores: the one given, else the scene's (``learner`` in its
     configuration, ``"score"``), else accuracy."""
-    score = score if score is not None else _scene_learner(data).get("score", "accuracy")
+    score = score if score is not None else _scene_learner(data.scene).get("score", "accuracy")
     if score not in SCORES:
         raise AffordError(f"{art.source if art else 'the data'} asks for an unknown selection score {score!r}; "
                           "give --score")

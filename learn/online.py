@@ -5,7 +5,7 @@ learning its label) costs an interaction, looking at it costs nothing. Two phase
 
 - **bootstrap**: the first ``bootstrap`` candidates are all tried; ReliefF on them picks the
   ``n_features`` most relevant features once (the thesis took 250 of 35 100), and a first
-  linear SVM is fitted;
+  SVM is fitted;
 - **curiosity**: each later candidate is tried only if the strategy finds it interesting,
   and the SVM is refitted on everything tried so far (the thesis updated LASVM online;
   refitting a linear SVM on at most a few thousand rows of 250 features costs milliseconds
@@ -18,7 +18,9 @@ Strategies (the active-learning field's names):
 ``margin``
     the thesis's: try when the SVM's output ``|w.x + b|`` is below ``tau`` (0.5 in the
     thesis; its margins lie at 1). With more than two categories, the margin is half the
-    gap between the two largest one-vs-rest outputs;
+    gap between the two largest one-vs-rest outputs (the linear SVM's are distances; the
+    RBF SVM's are scikit-learn's one-vs-one votes turned into one-vs-rest scores, so
+    ``tau`` is on that scale there);
 ``entropy``
     try when the entropy of calibrated probabilities (Platt's sigmoid, or with more than
     two categories a multinomial logistic regression, fitted out of fold to the SVM's
@@ -126,8 +128,22 @@ def _margin(d: np.ndarray) -> float:
 
 def _normalised_entropy(p: np.ndarray) -> float:
     """The entropy of the probabilities ``p`` over K categories, in units of log2 K (bits for two)."""
-    p = np.clip(np.ravel(p), 1e-12, 1.0)
+    p = np.ravel(p)
+    if p.size == 2:  # bits, with the clip the two-result learner always had (budget ties rest on it)
+        q = float(np.clip(p[1], 1e-12, 1 - 1e-12))
+        return float(-(q * np.log2(q) + (1 - q) * np.log2(1 - q)))
+    p = np.clip(p, 1e-12, 1.0)
     return float(-(p * np.log2(p)).sum() / np.log2(p.size)) if p.size > 1 else 0.0
+
+
+def _probabilities(calibrator, d: np.ndarray) -> np.ndarray:
+    """The calibrated probabilities of one candidate's outputs ``d``; for two categories
+    Platt's sigmoid 1 / (1 + exp(a s + b)) written out, as the two-result learner had it."""
+    if calibrator.classes_.size == 2:
+        s = float(np.ravel(d)[0])
+        p = 1.0 / (1.0 + np.exp(-float(calibrator.coef_[0, 0]) * s - float(calibrator.intercept_[0])))
+        return np.array([1.0 - p, p])
+    return calibrator.predict_proba(_as_columns(d))[0]
 
 
 def _as_columns(d: np.ndarray) -> np.ndarray:
@@ -212,6 +228,8 @@ def _learn_online(X, label, strategy, *, bootstrap, tau, threshold, budget, comm
         if y_test is not None:
             y_test = np.asarray(encode(list(y_test)), dtype=int)
     labels.update(zip(range(bootstrap), yb.tolist()))
+    # given results may still show the one not seen yet; discovered categories are fixed now
+    one_category = encode is not None and np.unique(yb).size < 2
     Xb = X[:bootstrap].astype(float)
     lo = Xb.min(axis=0)
     span = np.where(Xb.max(axis=0) > lo, Xb.max(axis=0) - lo, 1.0)
@@ -251,13 +269,15 @@ def _learn_online(X, label, strategy, *, bootstrap, tau, threshold, budget, comm
         z = Z[i:i + 1]
         if strategy == "random":
             go = True
+        elif one_category:  # the categories are fixed and there is one: nothing to learn, certain everywhere
+            interest[i] = np.inf if strategy == "margin" else 0.0 if strategy == "entropy" else 1.0
+            go = False
         elif strategy == "margin":
             interest[i] = _margin(learner.decision(z)[0])
             go = interest[i] < tau
         elif strategy == "entropy":
-            # no calibration yet (too few rows, or one category seen): certain of nothing
-            interest[i] = 1.0 if calibrator is None else _normalised_entropy(
-                calibrator.predict_proba(_as_columns(learner.decision(z)))[0])
+            # no calibration yet (too few rows, or one result seen): certain of nothing
+            interest[i] = 1.0 if calibrator is None else _normalised_entropy(_probabilities(calibrator, learner.decision(z)))
             seen_entropy.append(interest[i])
             if budget is None:
                 go = interest[i] >= threshold

@@ -130,3 +130,11 @@ def test_at_the_table_it_is_curious_about_the_effect_categories_it_discovered(cu
     # the artefact is ordinary interactions: the table's pipeline takes it
     ok(["cluster", str(d / "cur.afford"), "-o", str(d / "e.afford")])
     ok(["train", str(d / "e.afford"), "-o", str(d / "m.afford")])
+
+
+def test_a_table_test_set_without_first_steps_of_a_behaviour_is_refused(tmp_path):
+    ok(["explore", "--episodes", "2", "--seed", "1", "-o", str(tmp_path / "tiny.afford")])
+    r = runner.invoke(app, ["explore", "--strategy", "entropy", "--candidates", "14", "--bootstrap", "10",
+                            "--test", str(tmp_path / "tiny.afford"), "-o", str(tmp_path / "x.afford")])
+    assert r.exit_code == 1 and "have no first step of behaviour" in r.output
+    assert not (tmp_path / "x.afford").exists()

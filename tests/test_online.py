@@ -114,3 +114,11 @@ def test_curiosity_over_discovered_categories_beats_random_at_equal_interactions
         for s in gain:
             gain[s].append(acc[s] - acc["random"])
     assert all(np.median(g) > 0 for g in gain.values()), gain
+
+
+def test_one_discovered_category_leaves_nothing_to_be_curious_about():
+    X, E, _ = planted_effects(7, 200)
+    one = lambda outcomes, rows: (lambda E: np.zeros(len(E), dtype=int))  # every effect alike
+    for strategy in ("margin", "entropy", "committee"):
+        run = learn_online(X, E, strategy, bootstrap=25, categorise=one, seed=0)
+        assert run.n_tried == 25, strategy  # the bootstrap only: the categories are fixed and there is one
