@@ -27,6 +27,27 @@ def parser(doc: str):
     return ap
 
 
+def stream_parser(doc: str, situations: str):
+    """:func:`parser` with the overrides of the curiosity scripts' candidate streams:
+    ``--candidates``, ``--test-size`` (test ``situations``) and ``--orderings``."""
+    ap = parser(doc)
+    ap.add_argument("--candidates", type=int, help="override the mode's number of candidates")
+    ap.add_argument("--test-size", type=int, help=f"override the mode's number of test {situations}")
+    ap.add_argument("--orderings", type=int, help="override the mode's number of orderings")
+    return ap
+
+
+def quartiles(values) -> dict:
+    """Median and quartiles (rounded to 4 places) of the finite ``values``, and how many there were."""
+    import numpy as np
+
+    v = np.asarray([x for x in values if np.isfinite(x)], dtype=float)
+    if v.size == 0:
+        return {"median": None, "q1": None, "q3": None, "n": 0}
+    q1, med, q3 = np.percentile(v, [25, 50, 75])
+    return {"median": round(float(med), 4), "q1": round(float(q1), 4), "q3": round(float(q3), 4), "n": int(v.size)}
+
+
 def train_model(scene: str, args, directory: Path) -> str:
     """Explore ``scene`` and learn as ``afford select-features | afford train`` does; the
     model's path in ``directory``. ``args.episodes`` sizes the exploration if given; else 100

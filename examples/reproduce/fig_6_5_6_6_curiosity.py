@@ -40,7 +40,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser  # noqa: E402
+from _common import commit, quartiles, stream_parser  # noqa: E402
 
 NAME = "fig_6_5_6_6_curiosity"
 CHECKPOINTS = (100, 250, 400)
@@ -98,14 +98,6 @@ def at(curve: list[dict], k: int) -> float:
 
 def needed(curve: list[dict], target: float) -> float:
     return next((float(c["interactions"]) for c in curve if c["accuracy"] >= target), float("nan"))
-
-
-def quartiles(values) -> dict:
-    v = np.asarray([x for x in values if np.isfinite(x)], dtype=float)
-    if v.size == 0:
-        return {"median": None, "q1": None, "q3": None, "n": 0}
-    q1, med, q3 = np.percentile(v, [25, 50, 75])
-    return {"median": round(float(med), 4), "q1": round(float(q1), 4), "q3": round(float(q3), 4), "n": int(v.size)}
 
 
 def run(args) -> dict:
@@ -202,11 +194,7 @@ def write(doc: dict, args) -> None:
 
 
 def main() -> None:
-    ap = parser(__doc__)
-    ap.add_argument("--candidates", type=int, help="override the mode's number of candidates")
-    ap.add_argument("--test-size", type=int, help="override the mode's number of test situations")
-    ap.add_argument("--orderings", type=int, help="override the mode's number of orderings")
-    args = ap.parse_args()
+    args = stream_parser(__doc__, "situations").parse_args()
     if args.candidates is not None and args.candidates < 110:
         sys.exit("error: --candidates must be at least 110 (the largest bootstrap, 100, and some to choose from)")
     write(run(args), args)

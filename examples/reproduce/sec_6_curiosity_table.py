@@ -31,7 +31,7 @@ Full mode: 1500 candidates, 600 test objects, 10 orderings; ``--quick``: 450, 25
 Writes ``DIR/sec_6_curiosity_table.{md,json,png}``; the JSON's ``rows`` hold one row per
 labels, behaviour, strategy and checkpoint: ``labels`` ("discovered", or "outcome" for
 the diagnosis), ``behavior``, ``strategy``, ``interactions``, ``median``, ``q1``, ``q3``
-(test accuracy over the orderings), ``tried`` (interactions the strategy had tried by
+(test accuracy over the orderings, ``n`` of them), ``tried`` (interactions the strategy had tried by
 then, median) and ``thesis`` (null).
 """
 
@@ -46,7 +46,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser  # noqa: E402
+from _common import commit, quartiles, stream_parser  # noqa: E402
 
 NAME = "sec_6_curiosity_table"
 CHECKPOINTS = {True: (50, 100, 150), False: (50, 100, 200, 300, 500)}  # quick, full
@@ -84,11 +84,6 @@ def at(curve: list[dict], k: int) -> tuple[float, int]:
     """Test accuracy once ``k`` interactions were tried (the last point at or before k), and how many."""
     points = [c for c in curve if c["interactions"] <= k] or curve[:1]
     return points[-1]["accuracy"], points[-1]["interactions"]
-
-
-def quartiles(values) -> dict:
-    q1, med, q3 = np.percentile(np.asarray(values, dtype=float), [25, 50, 75])
-    return {"median": round(float(med), 4), "q1": round(float(q1), 4), "q3": round(float(q3), 4)}
 
 
 def run(args) -> dict:
@@ -197,11 +192,7 @@ def write(doc: dict, args) -> None:
 
 
 def main() -> None:
-    ap = parser(__doc__)
-    ap.add_argument("--candidates", type=int, help="override the mode's number of candidates")
-    ap.add_argument("--test-size", type=int, help="override the mode's number of test objects")
-    ap.add_argument("--orderings", type=int, help="override the mode's number of orderings")
-    args = ap.parse_args()
+    args = stream_parser(__doc__, "objects").parse_args()
     if args.candidates is not None and args.candidates < 2 * BOOTSTRAP:
         sys.exit(f"error: --candidates must be at least {2 * BOOTSTRAP} (the bootstrap, {BOOTSTRAP}, and as many to choose from)")
     write(run(args), args)
