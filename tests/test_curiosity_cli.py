@@ -22,20 +22,26 @@ def ok(args):
     return r
 
 
+def explore_curiously(d, scene: str, test_episodes: int, *curious: str) -> tuple[dict, np.ndarray]:
+    """A test set of ``scene``, then a curious exploration with it: the ``--json`` report and
+    which candidates x behaviours were tried (the artefact's ``online_tried``)."""
+    ok(["explore", "--scene", scene, "--episodes", str(test_episodes), "--seed", "50", "--workers", "2",
+        "-o", str(d / "test.afford")])
+    out = json.loads(ok(["explore", "--scene", scene, *curious, "--workers", "2", "--test", str(d / "test.afford"),
+                         "-o", str(d / "cur.afford"), "--json"]).stdout)
+    with zipfile.ZipFile(d / "cur.afford") as z:
+        return out, np.load(io.BytesIO(z.read("online_tried.npy")), allow_pickle=False)
+
+
 @pytest.fixture(scope="module")
 def curious(tmp_path_factory):
     d = tmp_path_factory.mktemp("curious")
-    ok(["explore", "--scene", "traverse-gaps", "--episodes", "12", "--seed", "50", "--workers", "2", "-o", str(d / "test.afford")])
-    out = json.loads(ok(["explore", "--scene", "traverse-gaps", "--strategy", "margin", "--candidates", "70",
-                         "--bootstrap", "35", "--seed", "3", "--workers", "2", "--test", str(d / "test.afford"),
-                         "--plots", str(d / "figs"), "-o", str(d / "cur.afford"), "--json"]).stdout)
-    return d, out
+    return d, *explore_curiously(d, "traverse-gaps", 12, "--strategy", "margin", "--candidates", "70", "--bootstrap", "35",
+                                 "--seed", "3", "--plots", str(d / "figs"))
 
 
 def test_it_tries_the_bootstrap_and_then_only_what_interests_it(curious):
-    d, out = curious
-    with zipfile.ZipFile(d / "cur.afford") as z:
-        tried = np.load(io.BytesIO(z.read("online_tried.npy")), allow_pickle=False)
+    d, out, tried = curious
     import afford
 
     data = afford.load_interactions(str(d / "cur.afford"))
@@ -55,7 +61,7 @@ def test_it_tries_the_bootstrap_and_then_only_what_interests_it(curious):
 
 
 def test_train_takes_what_curiosity_explored(curious, tmp_path):
-    d, _ = curious
+    d, _, _ = curious
     r = ok(["train", str(d / "cur.afford"), "-o", str(tmp_path / "m.afford"), "--json"])
     assert set(json.loads(r.stdout)["behaviors"]) == {"go-forward", "turn-left-20", "turn-right-20", "turn-left-40",
                                                        "turn-right-40", "turn-left-60", "turn-right-60"}
@@ -94,20 +100,15 @@ def test_curiosity_options_are_checked(tmp_path):
 @pytest.fixture(scope="module")
 def curious_table(tmp_path_factory):
     d = tmp_path_factory.mktemp("curious-table")
-    ok(["explore", "--episodes", "20", "--seed", "61", "--workers", "2", "-o", str(d / "test.afford")])
-    out = json.loads(ok(["explore", "--strategy", "entropy", "--candidates", "80", "--bootstrap", "30", "--seed", "5",
-                         "--workers", "2", "--test", str(d / "test.afford"), "-o", str(d / "cur.afford"),
-                         "--json"]).stdout)
-    return d, out
+    return d, *explore_curiously(d, "table", 20, "--strategy", "entropy", "--candidates", "80", "--bootstrap", "30",
+                                 "--seed", "5")
 
 
 def test_at_the_table_it_is_curious_about_the_effect_categories_it_discovered(curious_table):
     import afford
     from afford.sim.explore import scan_candidate
 
-    d, out = curious_table
-    with zipfile.ZipFile(d / "cur.afford") as z:
-        tried = np.load(io.BytesIO(z.read("online_tried.npy")), allow_pickle=False)
+    d, out, tried = curious_table
     data = afford.load_interactions(str(d / "cur.afford"))
     scene = afford.make_scene("table")
     assert tried.shape == (80, 4) and out["with_object"] <= 80
