@@ -197,6 +197,29 @@ def test_the_room_stays_and_the_robot_moves_and_another_room_differs():
     assert make_scene("traverse-room", room=1).describe()["room"] == 1
 
 
+def test_a_harder_room_holds_more_smaller_things_and_its_artefacts_rebuild_it(tmp_path):
+    import afford
+    from afford.sim.registry import make_scene
+    from tests.clitools import fails, ok
+
+    harder = make_scene("traverse-room", clutter=60, size_min=0.1, size_max=0.3)
+    loose = [it for it in harder.items() if not it.fixed]
+    assert len(loose) == 60 and all(0.1 <= v <= 0.3 for it in loose for v in it.size)
+    # robot-frame layouts of it hold every wall and loose object
+    assert len(harder.sample(np.random.default_rng(3)).items) == len(harder.items())
+    # the default room is described as before (artefacts keep their bytes); a harder one says so
+    assert "clutter" not in make_scene("traverse-room").describe()
+    assert make_scene("traverse-room", **harder.options_from(harder.describe())).items() == harder.items()
+    ok(["explore", "--scene", "traverse-room", "--clutter", "60", "--size-min", "0.1", "--size-max", "0.3",
+        "--episodes", "1", "-o", str(tmp_path / "h.afford")])
+    assert afford.load_interactions(str(tmp_path / "h.afford")).scene["clutter"] == 60
+    assert "--clutter does not apply to scene 'room'" in " ".join(
+        fails(["explore", "--scene", "room", "--clutter", "5", "-o", str(tmp_path / "x.afford")], 2).replace("│", " ").split())
+    assert "loose objects must satisfy 0.05 <= size-min" in fails(
+        ["explore", "--scene", "traverse-room", "--size-min", "0.03", "-o", str(tmp_path / "x.afford")])
+    assert not (tmp_path / "x.afford").exists()
+
+
 def test_a_wall_ahead_stops_the_robot_and_open_floor_does_not():
     from afford.sim.registry import make_scene
     from afford.sim.scenes.traverse_room import in_robot_frame, room_items

@@ -30,7 +30,8 @@ class Strategy(str, Enum):
     committee = "committee"
 
 
-def explore_online_command(output: str, scene: str, strategy: str, *, seed: int, workers: int, grid, layers, room, tau: float,
+def explore_online_command(output: str, scene: str, strategy: str, *, seed: int, workers: int, grid, layers, room,
+                           clutter=None, tau: float,
                            bootstrap: int, candidates: int, threshold: float, budget, test, plots, json: bool,
                            size_min=None, size_max=None, others: dict) -> None:
     """``explore --strategy``: curiosity-driven exploration (:mod:`afford.curiosity`)."""
@@ -45,7 +46,7 @@ def explore_online_command(output: str, scene: str, strategy: str, *, seed: int,
     check_output(output)
     plot_dir = plot_directory(plots) if plots is not None else None
     out = Output(json, stdout_busy=writes_stdout(output))
-    sc = make_scene(scene, grid=grid, layers=layers, room=room, size_min=size_min, size_max=size_max)
+    sc = make_scene(scene, grid=grid, layers=layers, room=room, clutter=clutter, size_min=size_min, size_max=size_max)
     test_data = read_rows(test, ("interactions",))[1] if test is not None else None
     start = time.perf_counter()
     with out.progress(f"curious about {sc.name}", candidates, lazy=True) as update:
@@ -149,6 +150,7 @@ def explore(
     grid: Annotated[Optional[int], typer.Option("--grid", min=1, max=60, help="Grid cells per side of the range image (scenes that perceive grid features: 5 in chapter 5, 30 in chapter 6).")] = None,
     layers: Annotated[Optional[int], typer.Option("--layers", min=1, max=8, help="Overlapping grid layers (4 in chapter 5, 1 in chapter 6).")] = None,
     room: Annotated[Optional[int], typer.Option("--room", min=0, help="Which room (its seed) the robot explores (traverse-room: chapter 6 learns in one room and tests in another; 0 by default).")] = None,
+    clutter: Annotated[Optional[int], typer.Option("--clutter", min=0, max=80, help="Loose objects in the room (traverse-room: 30 by default; with --size-min/--size-max, a harder room of more, smaller things).")] = None,
     shapes: Annotated[Optional[str], typer.Option("--shapes", metavar="S1,S2", help="The shapes the scene's objects are drawn from (traverse-one, thesis 5.6.4.1: box, cylinder, lying-cylinder, sphere; all four by default).")] = None,
     furniture: Annotated[Optional[str], typer.Option("--furniture", help="The piece in front of the robot (traverse-furniture, thesis 5.6.4.2): wooden-table, iron-table or chair.")] = None,
     backend: Annotated[Backend, typer.Option("--backend", help="Where episodes run: loky (processes on this machine) or dask (a LocalCluster of --workers on 127.0.0.1, or the cluster at --scheduler; needs the optional dask extra). The same --seed gives the same bytes on either.")] = Backend.loky,
@@ -173,6 +175,7 @@ def explore(
     --strategy the robot explores out of curiosity instead (thesis chapter 6)."""
     if strategy is not None:
         return explore_online_command(output, scene, strategy.value, seed=seed, workers=workers, grid=grid, layers=layers, room=room,
+                                      clutter=clutter,
                                       tau=tau, bootstrap=bootstrap, candidates=candidates, threshold=threshold,
                                       budget=budget, test=test, plots=plots, json=json, size_min=size_min, size_max=size_max,
                                       others={"--episodes": episodes, "--interactions": interactions,
@@ -205,6 +208,7 @@ def explore(
     check_output(output)
     out = Output(json, stdout_busy=writes_stdout(output))
     sc = make_scene(scene, size_min=size_min, size_max=size_max, max_steps=max_steps, grid=grid, layers=layers, room=room,
+                    clutter=clutter,
                     shapes=shapes, furniture=furniture)
     data, result = record(out, sc, output, episodes=episodes, interactions=interactions, seed=seed,
                           workers=workers, episode_start=episode_start or 0, backend=backend.value,

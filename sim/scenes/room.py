@@ -66,6 +66,8 @@ def furnished_room_items(room: int) -> tuple[Item, ...]:
 class FurnishedRoomScene(RoomScene):
     """A walled room of furniture and loose objects (see the module docstring)."""
 
+    options = {k: v for k, v in RoomScene.options.items() if k not in ("clutter", "size_min", "size_max")}
+
     summary = "a walled 6 x 6 m room of tables, chairs and 16 loose objects for the mobile robot to navigate (thesis 5.6.5)"
 
     def items(self) -> tuple[Item, ...]:

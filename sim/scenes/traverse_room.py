@@ -12,6 +12,8 @@ What is randomised
     Per room (the scene option ``room``, a seed; the test room is another one): 30 loose
     objects (boxes, upright and lying cylinders, spheres) of 20-40 cm at random places and
     yaws on a 6 x 6 m floor, walled by 1 m segments of 10 cm thick, 60 cm high fixed boxes.
+    The options ``clutter`` (how many loose objects) and ``size_min``/``size_max`` (their
+    dimensions) make a harder room: more, smaller things.
     The room stays the same from episode to episode; per episode: where the robot stands
     in it and which way it faces (anywhere at least 40 cm inside the walls, on no object),
     and range noise. The world is built in the robot's start frame, as every traverse
@@ -51,10 +53,10 @@ _DIMS = {"box": 3, "cylinder": 2, "lying-cylinder": 2, "sphere": 1}
 
 
 @lru_cache(maxsize=8)
-def room_items(room: int) -> tuple[Item, ...]:
-    """Room ``room``'s walls and objects, in the room's frame (its centre, metres)."""
+def room_items(room: int, clutter: int = N_OBJECTS, sizes: tuple[float, float] = SIZES) -> tuple[Item, ...]:
+    """Room ``room``'s walls and ``clutter`` objects of ``sizes``, in the room's frame (its centre, metres)."""
     rng = np.random.default_rng(np.random.SeedSequence(entropy=int(room), spawn_key=(3,)))
-    return walls() + loose_objects(rng, N_OBJECTS)
+    return walls() + loose_objects(rng, clutter, sizes=sizes)
 
 
 def walls() -> tuple[Item, ...]:
@@ -67,14 +69,14 @@ def walls() -> tuple[Item, ...]:
     return tuple(out)
 
 
-def loose_objects(rng: np.random.Generator, n: int, taken: tuple = ()) -> tuple[Item, ...]:
-    """``n`` loose objects of 20-40 cm at random places and yaws on the floor, apart from
-    each other, from the walls and from the footprints ``taken``."""
+def loose_objects(rng: np.random.Generator, n: int, taken: tuple = (), sizes: tuple[float, float] = SIZES) -> tuple[Item, ...]:
+    """``n`` loose objects of ``sizes`` (20-40 cm) at random places and yaws on the floor,
+    apart from each other, from the walls and from the footprints ``taken``."""
     wall = tuple(w.footprint() for w in walls())
     objects: list[Item] = []
     while len(objects) < n:
         shape = SHAPES[int(rng.integers(len(SHAPES)))]
-        size = tuple(round(float(v), 4) for v in rng.uniform(*SIZES, size=_DIMS[shape]))
+        size = tuple(round(float(v), 4) for v in rng.uniform(*sizes, size=_DIMS[shape]))
         pos = tuple(round(float(v), 4) for v in rng.uniform(-HALF + 0.3, HALF - 0.3, size=2))
         it = Item(shape, size, pos, round(float(rng.uniform(0.0, 360.0)), 4))
         fp = it.footprint()
@@ -100,28 +102,45 @@ class RoomScene(TraverseScene):
     """The robot at a random place in one walled room of random objects (see the module docstring)."""
 
     summary = "the mobile robot at random places in one walled 6 x 6 m room of 30 objects of 20-40 cm (thesis chapter 6)"
-    options = {**TraverseScene.options, "room": "Which room (its seed): chapter 6 learns in one room and tests in another."}
+    options = {**TraverseScene.options, "room": "Which room (its seed): chapter 6 learns in one room and tests in another.",
+               "clutter": f"Loose objects in the room ({N_OBJECTS}).",
+               "size_min": f"Smallest loose-object dimension, metres ({SIZES[0]}).",
+               "size_max": f"Largest loose-object dimension, metres ({SIZES[1]})."}
 
-    def __init__(self, config=None, room: int = 0):
+    def __init__(self, config=None, room: int = 0, clutter: int = N_OBJECTS, sizes: tuple[float, float] = SIZES):
         super().__init__(config)
-        self.room = int(room)
+        self.room, self.clutter, self.sizes = int(room), int(clutter), (float(sizes[0]), float(sizes[1]))
 
     def describe(self) -> dict:
-        return {**super().describe(), "room": self.room}
+        harder = {} if (self.clutter, self.sizes) == (N_OBJECTS, SIZES) else {"clutter": self.clutter,
+                                                                             "sizes": list(self.sizes)}
+        return {**super().describe(), "room": self.room, **harder}  # the default room is described as it always was
 
     def options_from(self, description: dict) -> dict:
-        return {**super().options_from(description), "room": description.get("room", 0)}
+        lo, hi = description.get("sizes", SIZES)
+        return {**super().options_from(description), "room": description.get("room", 0),
+                "clutter": description.get("clutter", N_OBJECTS), "size_min": lo, "size_max": hi}
 
-    def configure(self, grid: int | None = None, layers: int | None = None, room: int | None = None) -> "RoomScene":
+    def configure(self, grid: int | None = None, layers: int | None = None, room: int | None = None,
+                  clutter: int | None = None, size_min: float | None = None,
+                  size_max: float | None = None) -> "RoomScene":
         scene = super().configure(grid, layers)
         scene.room = self.room if room is None else int(room)
+        scene.clutter = self.clutter if clutter is None else int(clutter)
+        lo = self.sizes[0] if size_min is None else float(size_min)
+        hi = self.sizes[1] if size_max is None else float(size_max)
+        scene.sizes = (lo, hi)
         if scene.room < 0:
             raise DataError(f"a room is a seed, 0 or more; got {scene.room}")
+        if not 0 <= scene.clutter <= 80:
+            raise DataError(f"a room holds 0-80 loose objects, got {scene.clutter}")
+        if not 0.05 <= lo <= hi <= 0.6:
+            raise DataError(f"loose objects must satisfy 0.05 <= size-min <= size-max <= 0.6 m, got {lo} and {hi}")
         return scene
 
     def items(self) -> tuple[Item, ...]:
         """The room's walls and objects in its own frame (its centre)."""
-        return room_items(self.room)
+        return room_items(self.room, self.clutter, self.sizes)
 
     def sample(self, rng: np.random.Generator) -> TraverseLayout:
         return self.stand(rng)[0]
