@@ -49,6 +49,7 @@ def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_pat
     # against the online learner given every candidate, random needs at most all it tried
     random = next(r for r in rows if r["figure"] == "strategies" and r["strategy"] == "random")
     assert random["online"]["n"] == 2 and 25 <= random["online"]["median"] <= 130
+    assert all(len(r["values"]) == 2 for r in rows)  # one per ordering, for the box plots
     assert "Figure 6.5" in (tmp_path / "fig_6_5_6_6_curiosity.md").read_text()
     assert (tmp_path / "fig_6_5_6_6_curiosity.png").read_bytes()[:4] == b"\x89PNG"
 

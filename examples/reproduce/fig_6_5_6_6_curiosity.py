@@ -32,8 +32,10 @@ Full mode: 3000 candidates, 2000 test situations, 10 orderings (about an hour he
 Writes ``DIR/fig_6_5_6_6_curiosity.{md,json,png}``; the JSON's ``rows`` hold one row per
 figure, setting and checkpoint: ``figure`` ("6.5", "6.6" or "strategies"), ``bootstrap``,
 ``tau``, ``strategy``, ``interactions`` (the checkpoint), ``median``, ``q1``, ``q3`` (test
-accuracy over the orderings; for "strategies", the interactions needed), and ``thesis``
-where the thesis states a finding.
+accuracy over the orderings; for "strategies", the interactions needed), ``values`` (one
+per ordering; None where it never got there), and ``thesis`` where the thesis states a
+finding. The PNG draws them as box plots: figures 6.5 and 6.6, and the strategies'
+interactions needed (an ordering that never got there drawn at every candidate).
 """
 
 from __future__ import annotations
@@ -141,7 +143,9 @@ def run(args) -> dict:
     for (figure, strategy, bootstrap, tau), cs in by.items():
         base = {"figure": figure, "strategy": strategy, "bootstrap": bootstrap, "tau": tau}
         if figure == "strategies":
-            rows.append({**base, "interactions": None, **quartiles([needed(c, 0.95 * everything) for c in cs]),
+            values = [needed(c, 0.95 * everything) for c in cs]
+            rows.append({**base, "interactions": None, **quartiles(values),
+                         "values": [v if np.isfinite(v) else None for v in values],  # None: never reached
                          "online": quartiles([needed(c, 0.95 * end) for c, end in zip(cs, ends)]),
                          "tried": quartiles([c[-1]["interactions"] for c in cs]), "thesis": None})
             continue
@@ -192,7 +196,8 @@ def write(doc: dict, args) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 3.8), sharey=True)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 3.8), gridspec_kw={"width_ratios": [4, 5, 3]})
+    axes[1].sharey(axes[0])
     for ax, figure, key, values in ((axes[0], "6.5", "bootstrap", BOOTSTRAPS), (axes[1], "6.6", "tau", list(TAUS) + [None])):
         for i, v in enumerate(values):
             cells = [r for r in rows if r["figure"] == figure and r[key] == v and r["median"] is not None]
@@ -204,6 +209,14 @@ def write(doc: dict, args) -> None:
         ax.set_title(f"figure {figure}")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("test accuracy over the orderings (%)")
+    strategies = [r for r in rows if r["figure"] == "strategies"]
+    # an ordering that never reaches the target is drawn at every candidate (the most it could need)
+    axes[2].boxplot([[doc["candidates"] if v is None else v for v in r["values"]] for r in strategies],
+                    widths=0.6, patch_artist=True, boxprops={"facecolor": "#fdd0a2"}, medianprops={"color": "#a63603"})
+    axes[2].set_xticks(range(1, len(strategies) + 1), [r["strategy"] for r in strategies])
+    axes[2].set_ylabel("interactions to 95 % of all candidates' accuracy")
+    axes[2].set_title("strategies (bootstrap 25)")
+    axes[2].grid(alpha=0.3)
     fig.tight_layout()
     fig.savefig(out / f"{NAME}.png", dpi=110)
     print("\n".join(lines))
