@@ -131,8 +131,9 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
                               + ("effects" if discovered else "given results"))
     X = scan_candidates(scene, candidates, seed=seed, workers=workers,
                         progress=None if progress is None else (lambda d, t: progress("looking at candidates", d, t)))
-    if discovered and np.isfinite(X).all(axis=1).sum() < bootstrap:
-        raise AffordError(f"only {int(np.isfinite(X).all(axis=1).sum())} of the {candidates} candidates show an "
+    situations = int(np.isfinite(X).all(axis=1).sum())  # candidates with something to act on
+    if discovered and situations < bootstrap:
+        raise AffordError(f"only {situations} of the {candidates} candidates show an "
                           f"object, fewer than the bootstrap of {bootstrap}; draw more --candidates")
     settings = {"bootstrap": bootstrap, "tau": tau, "threshold": threshold, "budget": budget,
                 "n_features": n_features, "every": every}
@@ -173,7 +174,6 @@ def explore_online(scene, strategy: str = "margin", *, candidates: int = 3000, b
     pairs = sorted((i, b) for b in range(B) for i in learned[b][3])
     data = _tried_rows(scene, X, pairs, learned) if discovered else _given_rows(scene, X, pairs, learned)
     tried = np.stack([learned[b][0] for b in range(B)], axis=1)
-    situations = int(np.isfinite(X).all(axis=1).sum())  # candidates with something to act on
     report = {
         "strategy": strategy, "candidates": candidates, **settings, "kernel": kernel,
         "behaviors": {names[b]: {"tried": int(tried[:, b].sum()), "skipped": int(situations - tried[:, b].sum()),
