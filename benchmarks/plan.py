@@ -135,8 +135,10 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--crane-episodes", type=int, default=300, help="crane-lift episodes to learn from (0: skip the crane)")
     ap.add_argument("--crane-layouts", type=int, default=10)
-    ap.add_argument("--effects", default="members", choices=["members", "prototype"],
-                    help="the forward model's effects (members: each object's own; prototype: the thesis's)")
+    ap.add_argument("--effects", default="members", choices=["members", "prototype", "both"],
+                    help="the forward model's effects (members: each object's own; prototype: the thesis's; both: "
+                         "members, and beside it on every scene and goal, interleaved, prototype's assessment and "
+                         "ranking times, reported under by_effects)")
     ap.add_argument("--grasp-model", help="a grasp model for the alpha-choice timing (default: explore and train one)")
     ap.add_argument("--grasp-interactions", type=int, default=3000, help="grasp interactions to learn from (0: skip)")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "plan.json"))
@@ -160,7 +162,10 @@ def main() -> None:
     except Exception:  # the extra is not installed: no comparison
         pddl = False
     model = load_model(model_path)
+    both = args.effects == "both"
+    args.effects = "members" if both else args.effects
     model.effect_model = args.effects
+    beside = []  # with --effects both: per scene and goal, the prototype's assess and rank3 times
     goals = {
         "all three gone": ["0:visibility=0", "1:visibility=0", "2:visibility=0"],
         "object 0 pushed 20 cm away": None,  # filled per scene
@@ -174,6 +179,18 @@ def main() -> None:
         x = state[0, model.schema.index("x_min")]
         for name, exprs in goals.items():
             exprs = exprs or [f"0:x_min={x + 0.2:.3f}~0.06"]
+            if both:  # the thesis's model on the same goal, just before the members model
+                other = {}
+                fm = forward_model(model, effects="prototype")
+                goal = parse_goal(exprs, model.schema)
+                plan = best_first(fm, state, goal, max_depth=5, max_nodes=20000)
+                t0 = time.perf_counter()
+                assess(fm, state, goal, plan, max_depth=5, max_nodes=20000)
+                other["assess_seconds"] = time.perf_counter() - t0
+                t0 = time.perf_counter()
+                rank_plans(forward_model(model, effects="prototype"), state, goal, 3, max_depth=5, max_nodes=20000)
+                other["rank3_seconds"] = time.perf_counter() - t0
+                beside.append(other)
             fm = forward_model(model, effects=args.effects)  # a fresh cache: every plan pays for its own predictions
             goal = parse_goal(exprs, model.schema)
             plan = best_first(fm, state, goal, max_depth=5, max_nodes=20000)
@@ -221,6 +238,16 @@ def main() -> None:
                         "mean_seconds": round(float(np.mean([r["seconds"] for r in rows if r["goal"] == g])), 4)}
                     for g in goals},
     }
+    if both:
+        def mean(rs, key):
+            return round(float(np.mean([r[key] for r in rs])), 4)
+
+        result["by_effects"] = {
+            "members": {"assess_seconds_mean": mean(rows, "assess_seconds"), "rank3_seconds_mean": mean(rows, "rank3_seconds")},
+            "prototype": {"assess_seconds_mean": mean(beside, "assess_seconds"), "rank3_seconds_mean": mean(beside, "rank3_seconds")}}
+        result["by_effects"]["ratio"] = {
+            k: round(result["by_effects"]["members"][k] / max(result["by_effects"]["prototype"][k], 1e-9), 2)
+            for k in ("assess_seconds_mean", "rank3_seconds_mean")}
     if pddl:
         def stat(key, g=None):
             vals = [r[key] for r in rows if g is None or r["goal"] == g]

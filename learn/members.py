@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MemberEffects", "K_GRID"]
+__all__ = ["MemberEffects", "JointMembers", "K_GRID"]
 
 #: Neighbour counts tried; 0 means every member of the category (the thesis's prototype).
 K_GRID = (3, 5, 10, 20, 0)
@@ -165,6 +165,31 @@ class MemberEffects:
                 else np.zeros(0, dtype=np.int64)
             segments = np.concatenate([[0], np.cumsum(taken[cats])])[:-1]
             self._by_k.append((k, cols, cats, pick, segments, taken[cats].astype(float)))
+        # The same members laid out one padded row per category (padding: never nearer than
+        # a member), so that one partition finds every category's nearest at once
+        # (:meth:`_nearest`) instead of a loop over the categories.
+        cats = np.flatnonzero(counts)
+        self._cats = cats
+        self._width = int(counts.max()) if cats.size else 0
+        self._near_k = min(self._kmax, self._width)
+        slot_of_cat = np.full(n_cat, -1, dtype=np.int64)
+        slot_of_cat[cats] = np.arange(cats.size)
+        rank = np.arange(self._lab.size) - self._start[self._lab]
+        self._slot = slot_of_cat[self._lab] * self._width + rank  # grouped position -> padded position
+        self._pad_counts = counts[cats]
+        self._row_base = np.arange(cats.size) * self._width
+        self._pad_start = self._start[cats]
+        self._Ep = np.zeros((cats.size * self._width, self._E.shape[1]))
+        self._Ep[self._slot] = self._Es
+        # per distinct k > 0: the channels' columns and, per category, how many of its
+        # nearest the mean takes (its count, where smaller than k)
+        # (and those columns of the padded effects, contiguous)
+        self._pad_by_k = []
+        for k, cols, *_ in self._by_k:
+            if k > 0:
+                taken = np.minimum(self._pad_counts, k)
+                self._pad_by_k.append((min(k, self._near_k), cols, taken, np.flatnonzero(taken < min(k, self._near_k)),
+                                       np.ascontiguousarray(self._Ep[:, cols])))
 
     # -- predicting ------------------------------------------------------------------------
     def _grouped(self, x: np.ndarray) -> np.ndarray:
@@ -199,6 +224,44 @@ class MemberEffects:
             grouped[..., start: start + k] = start + np.take_along_axis(near, order[..., :k], axis=-1)
         return grouped
 
+    def _nearest(self, x: np.ndarray) -> np.ndarray:
+        """Per category with members (in id order), the padded positions of its
+        ``min(count, largest k)`` members nearest to input ``x``, nearest first, ties to the
+        lower row: what :meth:`_grouped` finds, in one partition for every category and
+        query. Shape ``(..., categories, largest k)``; a position is the member's place in
+        the padded layout (``_Ep``'s row); past a category's count they are padding. The
+        distances are computed exactly as :meth:`_grouped` computes them."""
+        z = (np.asarray(x, dtype=float) - self.shift_) * self.weight_
+        d = self._sq - 2.0 * (z @ self._ZT)
+        lead = d.shape[:-1]
+        n_cat, width, k = self._cats.size, self._width, self._near_k
+        if k <= 0:
+            return np.zeros(lead + (n_cat, 0), dtype=np.int64)
+        flat = d.reshape(-1, d.shape[-1])
+        queries = flat.shape[0]
+        padded = np.full((queries, n_cat * width), np.inf)
+        padded[:, self._slot] = flat
+        padded = padded.reshape(-1, width)  # one row per (query, category)
+        rows = np.arange(padded.shape[0])[:, None]
+        if k < width:
+            # the k nearest (a set) and, in place k, the next one: a tie across the boundary
+            # shows as the next one as near as the k-th
+            part = np.argpartition(padded, (k - 1, k), axis=-1)
+            edge = padded[rows[:, 0], part[:, k - 1]] == padded[rows[:, 0], part[:, k]]
+            near = part[:, :k]
+            near.sort(axis=-1)  # lower positions first, so the stable sort breaks ties by row
+        else:
+            near = np.tile(np.arange(width), (padded.shape[0], 1))
+        near = near[rows, np.argsort(padded[rows, near], axis=-1, kind="stable")]
+        if k < width:
+            # which of the tied the partition kept is arbitrary: such a category is sorted
+            # whole (padding sorts last, farther than every member)
+            tied = edge & (self._pad_counts > k if queries == 1 else np.tile(self._pad_counts > k, queries))
+            for r in np.flatnonzero(tied):
+                near[r] = np.argsort(padded[r], kind="stable")[:k]
+        return (near + (self._row_base if queries == 1 else np.tile(self._row_base, queries))[:, None]).reshape(
+            lead + (n_cat, k))
+
     def has(self, category: int) -> bool:
         return int(category) in self._rows
 
@@ -213,8 +276,10 @@ class MemberEffects:
         if k == 0 or k >= rows.size:
             return rows
         start = int(self._start[int(category)])
-        grouped = self._grouped(x) if grouped is None else grouped
-        return self._perm[grouped[start: start + k]]
+        if grouped is not None:
+            return self._perm[grouped[start: start + k]]
+        c = int(np.searchsorted(self._cats, int(category)))
+        return self._perm[start + self._nearest(x)[c, :k] - self._row_base[c]]
 
     def means(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(mean effect per category id, shape (n_categories, n_features); which ids have
@@ -223,14 +288,19 @@ class MemberEffects:
         table per row (leading axis), in one pass for all."""
         x = np.asarray(x, dtype=float)
         out = np.array(np.broadcast_to(self._all_means, x.shape[:-1] + self._all_means.shape))
-        grouped = None
-        for k, cols, cats, pick, segments, taken in self._by_k:
-            if k == 0:
-                continue  # every member: the category's mean already
-            if grouped is None:
-                grouped = self._grouped(x)
-            picked = self._Es[grouped[..., pick]][..., cols]  # (..., picked members, columns)
-            sums = np.add.reduceat(picked, segments, axis=-2)
+        if not self._pad_by_k:
+            return out, self._known  # every channel takes every member: the categories' means
+        near = self._nearest(x)
+        lead, cats = near.shape[:-2], self._cats
+        near = near.reshape(-1, near.shape[-1])
+        for k, cols, taken, short, Ep in self._pad_by_k:
+            picked = Ep[near[:, :k]]  # (queries x categories, nearest, columns)
+            # the sums run nearest first (the order they were always taken in: a sum over the
+            # middle axis adds row after row)
+            sums = picked.sum(axis=1).reshape(lead + (cats.size, cols.size))
+            for c in short:  # a category smaller than k: its sum stops at its count
+                sums[..., c, :] = np.cumsum(picked.reshape(lead + (cats.size, k, cols.size))[..., c, :, :],
+                                            axis=-2)[..., taken[c] - 1, :]
             out[..., cats[:, None], cols[None, :]] = sums / taken[:, None]
         return out, self._known
 
@@ -289,3 +359,81 @@ class MemberEffects:
         self.shift_, self.weight_ = shift.astype(float), weight.astype(float)
         self._index()
         return self
+
+
+class JointMembers:
+    """Several behaviours' member effects asked about one entity at once.
+
+    A planning search that expands a state asks every behaviour what it would do to the
+    object that just changed; each :meth:`MemberEffects.means` is a dozen small numpy
+    calls, and their overhead, not the arithmetic, is what a search pays. This lays every
+    behaviour's categories out as the rows of one padded table, so one partition and one
+    gather per neighbour count serve them all. The numbers are :meth:`MemberEffects.means`'s
+    to the bit: the same distances, the same nearest members in the same order, summed in
+    the same order (``tests/test_members.py`` holds it to that).
+    """
+
+    def __init__(self, members):
+        self.members = list(members)
+        ms = self.members
+        if len({m._Ep.shape[1] for m in ms}) > 1:
+            raise ValueError("the behaviours' member effects have different effect columns")
+        self._width = max((m._width for m in ms), default=0)
+        self._k = min(max((m._near_k for m in ms), default=0), self._width)
+        n_rows = [m._cats.size for m in ms]
+        self._row_off = np.concatenate([[0], np.cumsum(n_rows)]).astype(np.int64)
+        W, R = self._width, int(self._row_off[-1])
+        self._slot = np.concatenate([(off + m._slot // max(m._width, 1)) * W + m._slot % max(m._width, 1)
+                                     for off, m in zip(self._row_off, ms)]) if ms else np.zeros(0, dtype=np.int64)
+        self._counts = np.concatenate([m._pad_counts for m in ms]) if ms else np.zeros(0, dtype=np.int64)
+        self._row_base = np.arange(R) * W
+        F = ms[0]._Ep.shape[1] if ms else 0
+        Ep = np.zeros((R, W, F))
+        for off, m in zip(self._row_off, ms):
+            Ep[off: off + m._cats.size, : m._width] = m._Ep.reshape(m._cats.size, m._width, F)
+        Ep = Ep.reshape(R * W, F)
+        self._out_off = np.concatenate([[0], np.cumsum([m._all_means.shape[0] for m in ms])]).astype(np.int64)
+        self._out0 = np.concatenate([m._all_means for m in ms]) if ms else np.zeros((0, F))
+        groups: dict = {}
+        for j, m in enumerate(ms):
+            for k, cols, taken, _short, _ in m._pad_by_k:
+                g = groups.setdefault((k, cols.tobytes()), {"k": k, "cols": cols, "rows": [], "out": [], "taken": []})
+                g["rows"].append(self._row_off[j] + np.arange(m._cats.size))
+                g["out"].append(self._out_off[j] + m._cats)
+                g["taken"].append(taken)
+        self._groups = []
+        for g in groups.values():
+            taken = np.concatenate(g["taken"])
+            self._groups.append((g["k"], g["cols"], np.concatenate(g["rows"]), np.concatenate(g["out"]), taken,
+                                 np.flatnonzero(taken < g["k"]), np.ascontiguousarray(Ep[:, g["cols"]])))
+
+    def means(self, xs) -> list[tuple[np.ndarray, np.ndarray]]:
+        """``[m.means(x) for m, x in zip(members, xs)]`` for one input per behaviour."""
+        ms = self.members
+        out = self._out0.copy()
+        k, W = self._k, self._width
+        if k > 0:
+            d = [m._sq - 2.0 * (((np.asarray(x, dtype=float) - m.shift_) * m.weight_) @ m._ZT) for m, x in zip(ms, xs)]
+            padded = np.full(self._row_base.size * W, np.inf)
+            padded[self._slot] = np.concatenate(d)
+            padded = padded.reshape(-1, W)
+            rows = np.arange(padded.shape[0])[:, None]
+            if k < W:
+                part = np.argpartition(padded, (k - 1, k), axis=-1)
+                edge = padded[rows[:, 0], part[:, k - 1]] == padded[rows[:, 0], part[:, k]]
+                near = part[:, :k]
+                near.sort(axis=-1)
+            else:
+                near = np.tile(np.arange(W), (padded.shape[0], 1))
+            near = near[rows, np.argsort(padded[rows, near], axis=-1, kind="stable")]
+            if k < W:
+                for r in np.flatnonzero(edge & (self._counts > k)):
+                    near[r] = np.argsort(padded[r], kind="stable")[:k]
+            near += self._row_base[:, None]
+            for kk, cols, grows, orows, taken, short, Ep in self._groups:
+                picked = Ep[near[grows, :kk]]  # (rows, nearest, columns)
+                sums = picked.sum(axis=1)
+                for i in short:
+                    sums[i] = np.cumsum(picked[i], axis=0)[taken[i] - 1]
+                out[orows[:, None], cols[None, :]] = sums / taken[:, None]
+        return [(out[self._out_off[j]: self._out_off[j + 1]], m._known) for j, m in enumerate(ms)]

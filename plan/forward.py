@@ -348,11 +348,9 @@ class ForwardModel:
                 for v, p in zip(todo, proba):
                     self._cache[(b, v.tobytes(), alpha)] = (classes, p)
                 self.predictions += len(todo)
-                if self.effects == "members" and model.members is not None and model.prototypes is not None:
-                    # every category's effect on each new vector, in the same batch
-                    means, known = model.members.means(np.stack([self._member_input(model, v, alpha) for v in todo]))
-                    for v, m in zip(todo, means):
-                        self._effect_cache[(b, v.tobytes(), alpha)] = (m, known)
+                # member effects wait until a vector's effect is asked for (:meth:`effect`):
+                # most vectors met are never expanded, and an effect costs about as much
+                # alone as in a batch
 
     def in_hand(self, before: np.ndarray, after: np.ndarray, obj: int) -> bool:
         """Did acting on ``obj`` leave it in the hand? Its height feature rose by more than ``raised``.
@@ -372,6 +370,20 @@ class ForwardModel:
             return members
         return None
 
+    def _joint_members(self):
+        """(behaviours, :class:`JointMembers`) of the behaviours without parameters whose
+        member effects are used, where there are two or more; else None."""
+        if not hasattr(self, "_joint"):
+            from afford.learn.members import JointMembers
+
+            group = [b for b, m in enumerate(self.behaviors)
+                     if m.members is not None and m.prototypes is not None and not m.parameters]
+            try:
+                self._joint = (group, JointMembers([self.behaviors[b].members for b in group])) if len(group) > 1 else None
+            except (ValueError, AttributeError):  # effect columns that differ: one behaviour at a time
+                self._joint = None
+        return self._joint
+
     def _member_input(self, model: BehaviorModel, f: np.ndarray, alpha: tuple) -> np.ndarray:
         return np.concatenate([f, self._alpha_columns(model, alpha)])
 
@@ -388,8 +400,15 @@ class ForwardModel:
         key = (b, f.tobytes(), alpha)
         hit = self._effect_cache.get(key)
         if hit is None:
-            means, known = model.members.means(self._member_input(model, f, alpha))
-            hit = self._effect_cache[key] = (means, known)
+            joint = self._joint_members() if alpha == () else None
+            if joint is not None and b in joint[0]:
+                # a search asks every behaviour about an object that just changed: answer
+                # them all at once (the same numbers as one by one)
+                for b2, answer in zip(joint[0], joint[1].means([f] * len(joint[0]))):
+                    self._effect_cache[(b2, key[1], ())] = answer
+                hit = self._effect_cache[key]
+            else:
+                hit = self._effect_cache[key] = model.members.means(self._member_input(model, f, alpha))
         means, known = hit
         return means[category] if category < known.size and known[category] else model.prototypes[category]
 

@@ -267,7 +267,8 @@ def _reach(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, ma
         nonlocal spent
         key = (np.round(state, 2).tobytes(), tuple((np.round(f, 2).tobytes(), b, o, h) for f, b, o, h in avoid), held)
         if key not in plans:
-            plans[key] = search(model, state, goal, method, avoid=avoid, held=held, **limits)
+            # an imagined replan is only run, never reported: its open-loop figure is not needed
+            plans[key] = search(model, state, goal, method, avoid=avoid, held=held, open_loop=False, **limits)
             spent += plans[key].expanded
         return plans[key]
 

@@ -199,10 +199,13 @@ def _actions(model: ForwardModel, state: np.ndarray, goal: Goal | None = None, h
 
 
 def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4, max_nodes: int = 20000,
-               heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1) -> Plan:
+               heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1, open_loop: bool = True) -> Plan:
     """Most probable plan.
 
     ``held``: the object in the hand at the start (-1: none); see :func:`_actions`.
+    ``open_loop``: set the plan's open-loop success probability (False: leave it 0, for a
+    caller that only runs the plan, as imagined replans do; it costs a walk over every
+    outcome of every step).
 
     ``avoid`` lists steps that surprised the robot during execution (see :func:`_distrust`):
     they cost more, so the search tries something else first, yet a behaviour that is the
@@ -210,12 +213,13 @@ def best_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth:
     of the search changes.
     """
     return best_plans(model, start, goal, 1, max_depth=max_depth, max_nodes=max_nodes,
-                      heuristic_weight=heuristic_weight, avoid=avoid, held=held)[0]
+                      heuristic_weight=heuristic_weight, avoid=avoid, held=held, open_loop=open_loop)[0]
 
 
 @one_blas_thread
 def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int, *, max_depth: int = 4,
-               max_nodes: int = 20000, heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1) -> list[Plan]:
+               max_nodes: int = 20000, heuristic_weight: float = 0.0, avoid: tuple = (), held: int = -1,
+               open_loop: bool = True) -> list[Plan]:
     """The ``n_plans`` most probable plans with different behaviour sequences, best first.
 
     The search goes on past the first plan until it has popped ``n_plans`` goal nodes whose
@@ -243,7 +247,8 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
                 continue
             sequences.add(sequence)
             plan = Plan(True, list(steps), math.exp(-cost), 0.0, expanded, generated, 0.0)
-            plan.success_probability = success_probability(model, start, goal, plan.steps)
+            if open_loop:
+                plan.success_probability = success_probability(model, start, goal, plan.steps)
             plan.seconds = time.perf_counter() - t0
             plan.tree = tree
             found.append(plan)
@@ -299,8 +304,9 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
 
 @one_blas_thread
 def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_depth: int = 4,
-                  max_nodes: int = 20000, avoid: tuple = (), held: int = -1) -> Plan:
-    """Forward chaining over each behaviour's most probable outcome (thesis chapter 7)."""
+                  max_nodes: int = 20000, avoid: tuple = (), held: int = -1, open_loop: bool = True) -> Plan:
+    """Forward chaining over each behaviour's most probable outcome (thesis chapter 7).
+    ``open_loop``: as for :func:`best_first`."""
     t0 = time.perf_counter()
     if goal.holds(start):
         return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
@@ -332,7 +338,8 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                 new = steps + (PlanStep(model.names[b], obj, alpha, out.category, out.probability, out.state),)
                 if goal.holds(out.state):
                     plan = Plan(True, list(new), float(np.prod([s.probability for s in new])), 0.0, expanded, generated)
-                    plan.success_probability = success_probability(model, start, goal, plan.steps)
+                    if open_loop:
+                        plan.success_probability = success_probability(model, start, goal, plan.steps)
                     plan.seconds = time.perf_counter() - t0
                     return plan
                 nxt.append((out.state, new, now_held))

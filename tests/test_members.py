@@ -149,3 +149,94 @@ def test_the_planner_moves_each_object_by_its_own_effect_and_rollouts_draw_from_
     assert tight_plan.found
     p = reach_probability(fm, wide, tight, tight_plan, max_replans=0, rollouts=200, seed=0)
     assert 0.05 < p < 0.85
+
+
+def _reference_means(m: MemberEffects, x: np.ndarray) -> np.ndarray:
+    """Every category's member-effect mean for ``x`` the slow way: every member sorted by its
+    distance (ties: the lower row), the nearest summed one after another."""
+    d = np.empty(m.labels_.size)
+    d[m._perm] = m._sq - 2.0 * (((x - m.shift_) * m.weight_) @ m._ZT)
+    out = np.zeros((int(m.labels_.max()) + 1, m.E_.shape[1]))
+    ch = np.asarray(m.effect_groups)
+    for c in np.unique(m.labels_):
+        rows = np.flatnonzero(m.labels_ == c)
+        out[c] = m._E[rows].mean(axis=0)
+        for channel in m.channels:
+            k = m.k_[channel]
+            if k == 0:
+                continue
+            near = rows[np.argsort(d[rows], kind="stable")[:k]]
+            cols = ch == channel
+            out[c, cols] = np.cumsum(m._E[near][:, cols], axis=0)[-1] / near.size
+    return out
+
+
+def test_member_means_are_the_nearest_members_sums_to_the_bit_one_behaviour_or_several():
+    """The planner's fast paths (one partition over every category, several behaviours in one
+    table) give the numbers a full sort and a plain running sum give, bit for bit: with ties
+    at the k-th distance, categories smaller than k, one query or many."""
+    from afford.learn.members import JointMembers
+
+    rng = np.random.default_rng(5)
+    models = []
+    for seed, n, cats in ((0, 400, 3), (1, 250, 4)):
+        X, E, _ = _planted(n, np.random.default_rng(seed))
+        X[10:40] = X[5]  # thirty members at one distance from any query: ties at the k-th
+        labels = rng.integers(0, cats, n)
+        labels[rng.random(n) < 0.5] = 0
+        labels[:12] = cats  # a category of 12 members: fewer than k = 20
+        m = _members(X, E, labels, k_grid=(3, 5))
+        m.k_ = {"position": 5, "colour": 20} if seed == 0 else {"position": 20, "colour": 3}
+        m._index()
+        models.append(m)
+    queries = np.vstack([rng.uniform(0, 1, (25, 2)), models[0].Z_[:1] * 0 + [[0.3, 0.5]], _planted(5, rng)[0]])
+    queries = np.vstack([queries, np.repeat(queries[:1], 2, axis=0)])
+    queries[-1] = models[0].shift_ + models[0].Z_[5] / np.where(models[0].weight_ > 0, models[0].weight_, 1)
+    joint = JointMembers(models)
+    for x in queries:
+        answers = joint.means([x, x])
+        for m, (got, known) in zip(models, answers):
+            want = _reference_means(m, x)
+            assert np.array_equal(m.means(x)[0], want)
+            assert np.array_equal(got, want) and np.array_equal(known, m._known)
+    for m in models:
+        assert np.array_equal(m.means(queries)[0], np.stack([_reference_means(m, x) for x in queries]))
+
+
+def test_the_planner_answers_the_same_with_every_shortcut_as_without():
+    """Member effects computed lazily and for every behaviour at once, and imagined replans
+    that skip their open-loop figure: the same plans, next states and probabilities as
+    asking one behaviour at a time."""
+    rng = np.random.default_rng(6)
+    X, E, labels = _planted(600, rng, noise=0.02)
+    m = _members(X, E, labels)
+    X2, E2, labels2 = _planted(500, np.random.default_rng(7), noise=0.03)
+    m2 = _members(X2, -E2, labels2, k_grid=(3, 10))
+    schema = FeatureSchema(("x", "colour"), ("position", "colour"))
+
+    def forward(joint: bool) -> ForwardModel:
+        behaviours = [BehaviorModel(name, _Const(), np.array([0, 1]),
+                                    np.array([[mm.E_[mm.labels_ == 0, 0].mean(), 0.0], [0.0, 0.0]]), members=mm)
+                      for name, mm in (("push", m), ("pull", m2))]
+        fm = ForwardModel(behaviours, schema, effects="members")
+        if not joint:
+            fm._joint = None  # every behaviour asked on its own
+        return fm
+
+    fast, slow = forward(True), forward(False)
+    assert fast._joint_members() is not None
+    start = np.array([[0.30, 0.5]])
+    for x in (0.10, 0.25, 0.38):
+        f = np.array([x, 0.5])
+        for b in (0, 1):
+            assert np.array_equal(fast.apply(start * 0 + f, 0, b, 0), slow.apply(start * 0 + f, 0, b, 0))
+    goal = parse_goal(["0:x=0.62~0.02"], schema)
+    plans = [best_first(fm, start, goal, max_depth=3) for fm in (fast, slow)]
+    assert plans[0].found and [(s.behavior, s.category, s.probability) for s in plans[0].steps] == \
+        [(s.behavior, s.category, s.probability) for s in plans[1].steps]
+    assert plans[0].success_probability == plans[1].success_probability
+    quiet = best_first(forward(True), start, goal, max_depth=3, open_loop=False)
+    assert [s.predicted.tobytes() for s in quiet.steps] == [s.predicted.tobytes() for s in plans[0].steps]
+    assert quiet.path_probability == plans[0].path_probability and quiet.success_probability == 0.0
+    p = [reach_probability(fm, start, goal, plan, rollouts=60, seed=3) for fm, plan in zip((fast, slow), plans)]
+    assert p[0] == p[1] and 0.0 < p[0] < 1.0
