@@ -13,6 +13,15 @@ a scene with none is skipped). The goal ``0:y_min=V~0.05`` is planned for (``aff
 defaults: three alternatives, each ranked by its probability of success with up to three
 replans) and executed with monitoring (``afford plan --execute``), once per effect model.
 
+``--targets free`` draws V without looking at any outcome instead: 10-25 cm to the left or
+right of the start (a side chosen at random among those where the object's whole footprint,
+as perceived, stays on the table), so the scenes kept are not the ones where the world was
+kind, and the predicted success can be compared with the reached rate without selection
+bias. ``--targets model`` lets the robot choose V from its own forward model, again before
+any outcome: where the most likely outcome of push-left or push-right (a side at random of
+those that move the object 8 cm or more and keep it on the table) is predicted to leave
+``y_min``. ``--effects`` runs one forward model only.
+
 ``--clear`` scenes of three objects within reach ask for all three gone (``*:visibility=0``
 for each), executed the same way: clearing must stay as good as it was.
 
@@ -61,7 +70,7 @@ def reachable(model_path: str, seed: int) -> tuple[float, list[float]] | None:
     return float(start[0, iy]), ends
 
 
-def run_goal(model_path: str, seed: int, goal: list[str], objects: int) -> dict | None:
+def run_goal(model_path: str, seed: int, goal: list[str], objects: int, effects=EFFECTS) -> dict | None:
     """Plan and execute ``goal`` in the scene of ``seed`` with each effect model (None: fewer
     than ``objects`` objects seen at the start)."""
     from afford import api
@@ -70,21 +79,64 @@ def run_goal(model_path: str, seed: int, goal: list[str], objects: int) -> dict 
     if api.world("table", seed=seed, objects=objects, reachable=True).perceive().shape[0] < objects:
         return None
     out = {}
-    for effects in EFFECTS:
-        m.effect_model = effects
+    for effect_model in effects:
+        m.effect_model = effect_model
         w = api.world("table", seed=seed, objects=objects, reachable=True)
         t = time.perf_counter()
         plan = m.plan(w.perceive(), goal)
         plan_s = time.perf_counter() - t
         run = m.execute(w, goal, first=plan) if plan.found else None
-        out[effects] = {"found": plan.found, "length": len(plan.steps), "p": plan.success_probability,
+        out[effect_model] = {"found": plan.found, "length": len(plan.steps), "p": plan.success_probability,
                         "p_open_loop": plan.open_loop_probability, "reached": bool(run and run.reached),
                         "replans": run.replans if run else None, "plan_seconds": plan_s,
                         "seconds": time.perf_counter() - t}
     return out
 
 
-def position_scene(model_path: str, seed: int) -> dict | None:
+def free_target(model_path: str, seed: int) -> float | None:
+    """V 10-25 cm to one side of the start, chosen without simulating any behaviour: the side
+    is drawn among those where the perceived footprint stays on the table (None: neither)."""
+    from afford import api
+    from afford.sim.world import TableConfig
+
+    m = api.load_model(model_path)
+    start = api.world("table", seed=seed, objects=1, reachable=True).perceive()
+    if start.shape[0] < 1 or not m.schema.visible(start[0]):
+        return None
+    y0, y1 = float(start[0, m.schema.index("y_min")]), float(start[0, m.schema.index("y_max")])
+    half = TableConfig().table_width / 2 - 0.02
+    rng = np.random.default_rng(seed)
+    d = float(rng.uniform(0.10, 0.25))
+    sides = [s for s in (-1.0, 1.0) if -half <= y0 + s * d and y1 + s * d <= half]
+    return None if not sides else y0 + float(rng.choice(sides)) * d
+
+
+def model_target(model_path: str, seed: int) -> float | None:
+    """V where the member-effect forward model expects one sideways push's most likely
+    outcome to leave the object's ``y_min`` (None: no push is expected to move it 8 cm or
+    more and keep it seen on the table)."""
+    from afford import api
+
+    m = api.load_model(model_path)
+    fm = m.forward(effects="members")
+    start = api.world("table", seed=seed, objects=1, reachable=True).perceive()
+    if start.shape[0] < 1 or not m.schema.visible(start[0]):
+        return None
+    iy = m.schema.index("y_min")
+    y0 = float(start[0, iy])
+    ends = []
+    for b in ("push-left", "push-right"):
+        outs = fm.outcomes(start, 0, m.names.index(b))
+        if outs and m.schema.visible(outs[0].state[0]) and abs(float(outs[0].state[0, iy]) - y0) >= 0.08:
+            ends.append(float(outs[0].state[0, iy]))
+    return float(np.random.default_rng(seed).choice(ends)) if ends else None
+
+
+def position_scene(model_path: str, seed: int, targets: str = "sim", effects=EFFECTS) -> dict | None:
+    if targets in ("free", "model"):
+        v = (free_target if targets == "free" else model_target)(model_path, seed)
+        row = v is not None and run_goal(model_path, seed, [f"0:y_min={v:.3f}~0.05"], 1, effects)
+        return row and {"seed": seed, "V": v, **row}
     found = reachable(model_path, seed)
     if found is None:
         return None
@@ -96,16 +148,16 @@ def position_scene(model_path: str, seed: int) -> dict | None:
             break
     else:
         return None
-    row = run_goal(model_path, seed, [f"0:y_min={v:.3f}~0.05"], 1)
+    row = run_goal(model_path, seed, [f"0:y_min={v:.3f}~0.05"], 1, effects)
     return row and {"seed": seed, "y0": y0, "V": v, **row}
 
 
-def summary(rows: list[dict]) -> dict:
+def summary(rows: list[dict], effects=EFFECTS) -> dict:
     out = {"scenes": len(rows)}
-    for effects in EFFECTS:
-        r = [x[effects] for x in rows]
+    for effect_model in effects:
+        r = [x[effect_model] for x in rows]
         found = [x for x in r if x["found"]]
-        out[effects] = {
+        out[effect_model] = {
             "found": len(found), "reached": sum(x["reached"] for x in r),
             "reached_rate": round(sum(x["reached"] for x in r) / max(1, len(r)), 3),
             # a scene with no plan counts as predicted 0 (and is not reached)
@@ -128,6 +180,10 @@ def main() -> None:
     ap.add_argument("--scenes", type=int, default=100)
     ap.add_argument("--clear", type=int, default=30)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--targets", choices=["sim", "free", "model"], default="sim",
+                    help="sim: V some push sequence reaches in simulation; free: V drawn without any outcome; "
+                         "model: V where the robot's forward model expects one push to leave the object")
+    ap.add_argument("--effects", choices=["both", *EFFECTS], default="both")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "position.json"))
     args = ap.parse_args()
@@ -139,10 +195,11 @@ def main() -> None:
     model_path = args.model or build_model(args.interactions, args.seed)
     build_s = None if args.model else round(time.perf_counter() - t, 1)
     base = 20_000 + 1000 * args.seed
-    pos = [r for r in Parallel(n_jobs=args.workers)(delayed(position_scene)(model_path, base + i)
+    effects = EFFECTS if args.effects == "both" else (args.effects,)
+    pos = [r for r in Parallel(n_jobs=args.workers)(delayed(position_scene)(model_path, base + i, args.targets, effects)
                                                     for i in range(args.scenes)) if r]
     clear = [r for r in Parallel(n_jobs=args.workers)(
-        delayed(run_goal)(model_path, base + 500 + i, [f"{j}:visibility=0" for j in range(3)], 3)
+        delayed(run_goal)(model_path, base + 500 + i, [f"{j}:visibility=0" for j in range(3)], 3, effects)
         for i in range(args.clear)) if r]
 
     from afford import api
@@ -157,7 +214,8 @@ def main() -> None:
               for name in model.names}
     emit({"benchmark": "position", "model_build_seconds": build_s, "model": model_path,
           "k": {n: model.members[n].k_ if model.members[n] is not None else None for n in model.names},
-          "positioning": summary(pos), "clearing": summary(clear), "effect_error": errors,
+          "targets": args.targets,
+          "positioning": summary(pos, effects), "clearing": summary(clear, effects), "effect_error": errors,
           "positioning_rows": pos}, args.out)
 
 
