@@ -135,7 +135,9 @@ def model_target(model_path: str, seed: int) -> float | None:
 def position_scene(model_path: str, seed: int, targets: str = "sim", effects=EFFECTS) -> dict | None:
     if targets in ("free", "model"):
         v = (free_target if targets == "free" else model_target)(model_path, seed)
-        row = v is not None and run_goal(model_path, seed, [f"0:y_min={v:.3f}~0.05"], 1, effects)
+        if v is None:
+            return None
+        row = run_goal(model_path, seed, [f"0:y_min={v:.3f}~0.05"], 1, effects)
         return row and {"seed": seed, "V": v, **row}
     found = reachable(model_path, seed)
     if found is None:
