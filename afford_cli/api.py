@@ -506,8 +506,9 @@ class Model(LoadedModel):
         return inverse_query(self.forward(min_probability=0.0), state, goal)
 
 
-#: Geometry features shown per entity, at most (an environment of 3900 features shows none).
-_SHOWN = 12
+#: Geometry features named per entity, at most: a grasp's 24 measurements are all given; a
+#: range image's grid of 300 cells, none (its entity is the whole scene, not an object).
+_SHOWN = 64
 
 
 def navigate(model, *, scene: str = "room", controller: str = "aggressive", seed: int = 0, room: int | None = None,

@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 
 import typer
 
-__all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "Alternatives", "SceneSeed", "Objects",
+__all__ = ["Seed", "Workers", "Json", "OutputPath", "InputPath", "SceneName", "ModelScene", "Alternatives", "SceneSeed", "Objects",
            "Layout", "MaxDepth", "MaxNodes", "MaxReplans", "check_scene_source", "Kernel", "KernelOption",
            "EffectModel", "Effects"]
 
@@ -17,6 +17,8 @@ Json = Annotated[bool, typer.Option("--json", help="Print one JSON object instea
 OutputPath = Annotated[str, typer.Option("--output", "-o", help="Where to write the artefact; '-' for stdout.")]
 InputPath = Annotated[str, typer.Argument(help="An afford artefact file, or '-' for stdin.", metavar="PATH|-")]
 SceneName = Annotated[str, typer.Option("--scene", help="A registered scene (see 'afford scenes').")]
+ModelScene = Annotated[Optional[str], typer.Option(
+    "--scene", help="A registered scene (see 'afford scenes'); default: the scene the model was learned in.")]
 Alternatives = Annotated[int, typer.Option(
     "--alternatives", min=1, max=10,
     help="Search this many of the most probable plans and take the one most likely to reach the goal with monitoring "

@@ -5,7 +5,7 @@ from __future__ import annotations
 from afford.errors import AffordError
 from afford.features.errors import DataError
 
-__all__ = ["make_scene", "scene_layout", "open_world", "explored_scene", "episode_starts"]
+__all__ = ["make_scene", "model_scene", "scene_layout", "open_world", "explored_scene", "episode_starts"]
 
 
 def make_scene(name: str, **options):
@@ -25,9 +25,32 @@ def make_scene(name: str, **options):
         raise AffordError(f"scene {name!r}: {exc}") from None
 
 
-def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_empty: bool = False, **drawn):
-    """The scene and a layout of it, from a layout file or drawn from the seed
-    (:func:`afford.api.scene_and_layout`, its errors as the command line reports them).
+def model_scene(model, name: str | None):
+    """The scene a command acts in with ``model``: the one named (``--scene``), else the
+    model's own, the scene it was explored in, rebuilt with the options it had (a traverse
+    model's grid, a table's size range). A scene that perceives otherwise than the model
+    is refused in one sentence naming both."""
+    own = model.art.manifest.get("scene")
+    own = own if isinstance(own, dict) else {}
+    own_name = own.get("name")
+    if name is None and not isinstance(own_name, str):
+        raise AffordError("this model does not say which scene it was learned in; give --scene NAME")
+    if name is None or name == own_name:
+        sc = explored_scene(own) or make_scene(own_name if name is None else name)
+    else:
+        sc = make_scene(name)
+    if sc.schema != model.schema:
+        learned = f" (it was learned in scene {own_name!r})" if isinstance(own_name, str) else ""
+        hint = "; leave out --scene to act in the model's own scene" if name is not None else ""
+        raise AffordError(f"scene {sc.name!r} perceives {len(sc.schema)} features, the model reads "
+                          f"{len(model.schema)}{learned}{hint}")
+    return sc
+
+
+def scene_layout(scene_name, seed: int | None, layout: str | None, allow_empty: bool = False, **drawn):
+    """The scene (a name, or a scene such as :func:`model_scene` gives) and a layout of it,
+    from a layout file or drawn from the seed (:func:`afford.api.scene_and_layout`, its
+    errors as the command line reports them).
 
     ``drawn`` holds the drawing options a command offers (``objects``, ``reachable``);
     one the scene does not take is a usage error, unless it was left unset.
@@ -40,7 +63,7 @@ def scene_layout(scene_name: str, seed: int | None, layout: str | None, allow_em
     if layout is None and seed is None:
         raise AffordError("give --layout FILE, or --seed S to draw a random scene")
     try:
-        return scene_and_layout(make_scene(scene_name), seed, layout, allow_empty=allow_empty, **drawn)
+        return scene_and_layout(make_scene(scene_name) if isinstance(scene_name, str) else scene_name, seed, layout, allow_empty=allow_empty, **drawn)
     except SceneOptionError as exc:
         raise typer.BadParameter(str(exc)) from None
     except DataError as exc:

@@ -41,7 +41,7 @@ def parse_layout(text: str, source: str = "layout") -> list[ObjectSpec]:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise LayoutError(f"{source} is not valid TOML ({exc})") from None
-    unknown_top = set(doc) - {"object"}
+    unknown_top = set(doc) - {"object", "scene"}  # the scene it names is checked when the file is read
     if unknown_top:
         raise LayoutError(f"{source}: unknown table {sorted(unknown_top)[0]!r}; a layout holds [[object]] entries")
     items = doc.get("object", [])

@@ -84,8 +84,33 @@ class Scene(Protocol):
 
 
 def load_layout_file(scene: Scene, path: str | Path):
-    """Read and parse a layout file for ``scene``; every mistake is one LayoutError sentence."""
-    return scene.parse_layout(read_layout_file(path), str(path))
+    """Read and parse a layout file for ``scene``; every mistake is one LayoutError sentence.
+
+    A layout may name the scene it was written for (``scene = "traverse"`` at its top); one
+    written for a scene whose layouts mean something else (another frame: the table's top
+    against the mobile robot's own) is refused. A layout that names none is read as the
+    scene's own."""
+    import tomllib
+
+    from afford.sim.layout import LayoutError
+    from afford.sim.registry import SceneNotFound, get_scene
+
+    text = read_layout_file(path)
+    try:
+        declared = tomllib.loads(text).get("scene")
+    except tomllib.TOMLDecodeError:
+        declared = None  # the scene's parser says what is wrong with it
+    if declared is not None:
+        if not isinstance(declared, str):
+            raise LayoutError(f"{path}: scene must be a scene's name, such as \"{scene.name}\"")
+        try:
+            written = get_scene(declared)
+        except SceneNotFound:
+            raise LayoutError(f"{path} is a layout of scene {declared!r}, which this afford does not have") from None
+        if getattr(written, "layout_format", declared) != getattr(scene, "layout_format", scene.name):
+            raise LayoutError(f"{path} is a layout of scene {declared!r}; scene {scene.name!r} reads layouts "
+                              "in another frame, so it cannot use it")
+    return scene.parse_layout(text, str(path))
 
 
 def check_options(scene: Scene, given: dict[str, Any], kind: str = "option") -> None:

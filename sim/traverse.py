@@ -497,7 +497,7 @@ def parse_layout(text: str, source: str = "layout") -> TraverseLayout:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise LayoutError(f"{source} is not valid TOML ({exc})") from None
-    unknown = set(doc) - set(_KEYS)
+    unknown = set(doc) - set(_KEYS) - {"scene"}  # the scene it names is checked when the file is read
     if unknown:
         raise LayoutError(f"{source}: unknown table {sorted(unknown)[0]!r}; a traverse layout holds "
                           "[[object]], [[ramp]] and [[gap]] entries")
@@ -575,6 +575,7 @@ class TraverseLayoutFiles:
     """What every scene whose layouts are :class:`TraverseLayout` does with layout files."""
 
     name = ""
+    layout_format = "traverse"  # robot-centred: x ahead of the robot, y to its left
 
     def parse_layout(self, text: str, source: str = "layout") -> TraverseLayout:
         return parse_layout(text, source)

@@ -47,6 +47,19 @@ def traverse_learned(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
+def grasp_learned(tmp_path_factory):
+    """A small grasp pipeline (chapter 9: behaviours with a parameter), made once."""
+    from tests.clitools import ok
+
+    d = tmp_path_factory.mktemp("grasp")
+    ok(["explore", "--scene", "grasp", "--interactions", "240", "--seed", "3", "--workers", "2", "-o", str(d / "train.afford")])
+    ok(["cluster", str(d / "train.afford"), "-o", str(d / "effects.afford")])
+    ok(["select-features", str(d / "effects.afford"), "-o", str(d / "features.afford")])
+    ok(["train", str(d / "features.afford"), "-o", str(d / "model.afford")])
+    return d
+
+
+@pytest.fixture(scope="session")
 def table():
     return get_scene("table")()
 

@@ -270,17 +270,37 @@ def test_cluster_forms_categories_by_the_channels_asked_and_refuses_unknown_ones
     assert not (tmp_path / "x.afford").exists()
 
 
-def test_the_grasp_scene_clusters_by_visibility_contact_point_and_touch_and_cuts_by_log_loss_unless_told(tmp_path):
-    i, e, e2 = (str(tmp_path / n) for n in ("i.afford", "e.afford", "e2.afford"))
-    ok(["explore", "--scene", "grasp", "--interactions", "240", "--seed", "3", "--workers", "2", "-o", i])
-    ok(["cluster", i, "-o", e])
+def test_the_grasp_scene_clusters_by_visibility_contact_point_and_touch_and_cuts_by_log_loss_unless_told(grasp_learned, tmp_path):
+    i, e, e2 = (str(grasp_learned / "train.afford"), str(grasp_learned / "effects.afford"), str(tmp_path / "e2.afford"))
     ok(["cluster", i, "-o", e2, "--channels", "visibility,border", "--kmax", "3"])
     own, told = (read_artifact(p).manifest["effects"]["power-grasp"] for p in (e, e2))
     assert (own["channels"], own["k_max"]) == (["visibility", "cp", "touch"], 4)
     assert (told["channels"], told["k_max"]) == (["visibility", "border"], 3)
     # and it cuts ReliefF's ranking by log loss unless told
-    f, f2 = str(tmp_path / "f.afford"), str(tmp_path / "f2.afford")
-    ok(["select-features", e, "-o", f])
+    f, f2 = str(grasp_learned / "features.afford"), str(tmp_path / "f2.afford")
     ok(["select-features", e, "-o", f2, "--score", "accuracy"])
     own, told = (read_artifact(p).manifest["relevance"]["power-grasp"] for p in (f, f2))
     assert (own["score"], told["score"]) == ("log_loss", "accuracy")
+
+
+def test_predict_on_a_grasp_model_runs_each_behaviour_with_the_alpha_it_chose_in_the_grasp_scene(grasp_learned):
+    from tests.clitools import fails
+
+    model = str(grasp_learned / "model.afford")
+    # no --scene: the model's own scene (grasp), not the table
+    out = json.loads(ok(["predict", model, "--seed", "5", "--check", "--json"]).stdout)
+    behaviours = out["objects"][0]["behaviors"]
+    assert out["checked"] == len(behaviours) == 5
+    for name, p in behaviours.items():
+        assert "observed_category" in p and "outcome" in p, name
+        # every one of the 24 measurements is named in the next state, not none of them
+        assert len(p["next"]["features"]) == 24 and "cp_x" in p["next"]["features"], name
+    with_alpha = [p for p in behaviours.values() if "alpha" in p]
+    assert len(with_alpha) == 5 and all(len(p["alpha"]) == 1 for p in with_alpha)
+    human = ok(["predict", model, "--seed", "5"]).stdout
+    assert "object 0: cp_x" in human and "scene 0" not in human
+    assert f"{with_alpha[2]['alpha'][0]:.2f}" in human  # the alpha each behaviour would use is shown
+    # another kind of scene is refused in one sentence naming both and the way out
+    msg = fails(["predict", model, "--scene", "traverse", "--seed", "1"])
+    assert msg.strip().splitlines() == ["error: scene 'traverse' perceives 3900 features, the model reads 25 "
+                                        "(it was learned in scene 'grasp'); leave out --scene to act in the model's own scene"]

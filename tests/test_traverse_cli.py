@@ -78,7 +78,7 @@ def test_predict_plot_draws_the_scan_and_each_moves_chance(learned, tmp_path):
     assert image.shape[1] >= 800 and image.shape[0] >= 300  # the scan beside seven bars
 
 
-def test_commands_refuse_what_does_not_apply_in_one_sentence(learned, tmp_path):
+def test_commands_refuse_what_does_not_apply_in_one_sentence(learned, pipeline, tmp_path):
     model = str(learned / "model.afford")
     assert "does not apply to scene 'traverse'" in fails(["explore", "--scene", "traverse", "--size-min", "0.1",
                                                            "-o", str(tmp_path / "x")], code=2)
@@ -91,7 +91,18 @@ def test_commands_refuse_what_does_not_apply_in_one_sentence(learned, tmp_path):
     assert "held" in fails(["predict", model, "--scene", "traverse", "--layout", str(table)])
     ramp = tmp_path / "ramp.toml"
     ramp.write_text("[[ramp]]\nposition = [0.6, 0.0]\nyaw = 0.0\nwidth = 1.0\nlength = 1.0\nslope = 10.0\n")
-    assert "unknown table 'ramp'" in fails(["predict", model, "--scene", "table", "--layout", str(ramp)])
+    assert "unknown table 'ramp'" in fails(["predict", str(pipeline / "model.afford"), "--layout", str(ramp)])
+    # a layout of the table's frame given to the mobile robot, and the other way round
+    shown = (table.read_text().replace("held = true\n", ""), 'scene = "traverse"\n' + ramp.read_text())
+    for text, declared, on, user in (("scene = \"table\"\n" + shown[0], "table", "traverse", model),
+                                      (shown[1], "traverse", "table", str(pipeline / "model.afford"))):
+        (tmp_path / "other.toml").write_text(text)
+        assert fails(["predict", user, "--layout", str(tmp_path / "other.toml")]).strip().splitlines() == [
+            f"error: {tmp_path / 'other.toml'} is a layout of scene '{declared}'; scene '{on}' reads layouts "
+            "in another frame, so it cannot use it"]
+    # and a table scene for a model of the mobile robot's moves: one sentence naming both
+    assert "(it was learned in scene 'traverse'); leave out --scene" in fails(
+        ["predict", model, "--scene", "table", "--seed", "1"])
     assert not (tmp_path / "x").exists()
 
 

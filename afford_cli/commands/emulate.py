@@ -11,17 +11,17 @@ from afford.commands.plan import render_plan
 from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
-from afford.options import AlphaRule, AlphaRuleOpt, EffectModel, Effects, Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, SceneName
+from afford.options import AlphaRule, AlphaRuleOpt, EffectModel, Effects, Alternatives, Json, MaxDepth, MaxNodes, MaxReplans, ModelScene
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
-from afford.scenes_io import open_world, scene_layout
+from afford.scenes_io import model_scene, open_world, scene_layout
 
 
 def emulate(
     model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
     observe: Annotated[str, typer.Option("--observe", help="Layout of the scene the robot is shown (the goal).")],
     start: Annotated[str, typer.Option("--start", help="Layout of the scene the robot starts from.")],
-    scene: SceneName = "table",
+    scene: ModelScene = None,
     execute: Annotated[bool, typer.Option("--execute/--no-execute", help="Run the plan in the simulator with monitoring.")] = True,
     max_depth: MaxDepth = 5,
     max_nodes: MaxNodes = 20000,
@@ -41,12 +41,12 @@ def emulate(
     loaded.effect_model = effects.value
     loaded.alpha_rule = alpha_rule.value
     loaded.check_effects("emulation")
-    sc, shown = scene_layout(scene, None, observe, allow_empty=True)
-    _, specs = scene_layout(scene, None, start)
+    sc = model_scene(loaded, scene)
+    _, shown = scene_layout(sc, None, observe, allow_empty=True)
+    _, specs = scene_layout(sc, None, start)
     observed = open_world(sc, shown, seed).perceive() if shown else np.empty((0, len(loaded.schema)))
     world = open_world(sc, specs, seed + 1)
     state = world.perceive()
-    loaded.check_schema(sc.schema, "this scene's perception")
     try:
         goal = goal_from_observation(observed, state, loaded.schema)
     except DataError as exc:

@@ -12,9 +12,9 @@ from afford.artifacts import write_artifact
 from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
-from afford.options import EffectModel, Effects, Json, Layout, MaxDepth, Objects, SceneName, SceneSeed, check_scene_source
+from afford.options import EffectModel, Effects, Json, Layout, MaxDepth, Objects, ModelScene, SceneSeed, check_scene_source
 from afford.output import Output
-from afford.scenes_io import open_world, scene_layout
+from afford.scenes_io import model_scene, open_world, scene_layout
 
 FILES = ("domain.pddl", "problem.pddl", "domain.ppddl", "problem.ppddl")
 
@@ -34,7 +34,7 @@ def pddl(
     model: Annotated[str, typer.Argument(help="A model artefact (effects discovered).", metavar="MODEL")],
     goal: Annotated[list[str], typer.Option("--goal", help="OBJ:FEATURE=VALUE~RANGE; repeat for several (all must hold).")],
     output: Annotated[str, typer.Option("--output", "-o", help="Directory for domain.pddl, problem.pddl, domain.ppddl, problem.ppddl.")],
-    scene: SceneName = "table",
+    scene: ModelScene = None,
     seed: SceneSeed = None,
     objects: Objects = None,
     layout: Layout = None,
@@ -57,9 +57,8 @@ def pddl(
     loaded.effect_model = effects.value
     loaded.check_effects("PDDL")
     g = parse_goal(goal, loaded.schema)
-    sc, specs = scene_layout(scene, seed, layout, objects=objects)
+    sc, specs = scene_layout(model_scene(loaded, scene), seed, layout, objects=objects)
     world = open_world(sc, specs, seed or 0)
-    loaded.check_schema(sc.schema, "this scene's perception")
     try:
         task = build_task(loaded.forward(), world.perceive(), g, max_depth=max_depth)
     except DataError as exc:

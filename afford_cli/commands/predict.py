@@ -16,10 +16,14 @@ from rich import box
 from rich.table import Table
 
 from afford.learning import load_model
-from afford.options import AlphaRule, AlphaRuleOpt, EffectModel, Effects, Json, Layout, Objects, SceneName, SceneSeed, check_scene_source
+from afford.options import AlphaRule, AlphaRuleOpt, EffectModel, Effects, Json, Layout, ModelScene, Objects, SceneSeed, check_scene_source
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
-from afford.scenes_io import open_world, scene_layout
+from afford.scenes_io import model_scene, open_world, scene_layout
+
+#: Features named in an entity's title, at most (the JSON has them all).
+_TITLED = 6
+
 
 def _change(now: dict, nxt: dict, shown: int = 2) -> str:
     """The features the step is expected to change most, with the spread: ``y_min -0.142±0.011``."""
@@ -27,7 +31,7 @@ def _change(now: dict, nxt: dict, shown: int = 2) -> str:
         return "gone from view"
     moves = sorted(((abs(v - now[n]), n, v - now[n]) for n, v in nxt["features"].items() if n in now), reverse=True)
     parts = [f"{n} {d:+.3f}±{nxt.get('spread', {}).get(n, 0.0):.3f}" for size, n, d in moves[:shown] if size >= 0.005]
-    return ", ".join(parts) or "none"
+    return "\n".join(parts) or "none"
 
 
 def check(model, scene, layout, seed: int, preds: list[dict]) -> dict:
@@ -38,7 +42,7 @@ def check(model, scene, layout, seed: int, preds: list[dict]) -> dict:
         for name, p in entry["behaviors"].items():
             world = open_world(scene, layout, seed)
             before = world.perceive()
-            after = world.act(name, entry["object"])
+            after = world.act(name, entry["object"], p.get("alpha"))  # the alpha reported, as reported
             seen[(entry["object"], name)] = after
             if model.label_source == "given":
                 actual = world.last_result
@@ -96,7 +100,7 @@ def draw(path: str, model, world, state, preds: list[dict], seen: dict | None) -
 
 def predict(
     model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
-    scene: SceneName = "table",
+    scene: ModelScene = None,
     seed: SceneSeed = None,
     objects: Objects = None,
     layout: Layout = None,
@@ -115,10 +119,9 @@ def predict(
     loaded.alpha_rule = alpha_rule.value
     if want:
         loaded.check_effects("an inverse query (--want)")
-    sc, specs = scene_layout(scene, seed, layout, objects=objects)
+    sc, specs = scene_layout(model_scene(loaded, scene), seed, layout, objects=objects)
     world = open_world(sc, specs, seed or 0)
     state = world.perceive()
-    loaded.check_schema(sc.schema, "this scene's perception")
     preds = loaded.predictions(state)
     seen = check(loaded, sc, specs, seed or 0, preds) if run_check else None
     result = {"objects": preds, "layout": sc.layout_json(specs), "label_source": loaded.label_source}
@@ -138,19 +141,25 @@ def predict(
     def render(console):
         given = loaded.label_source == "given"
         cats = {} if given else {n: {c["id"]: c for c in loaded.art.manifest["categories"][n]} for n in loaded.names}
+        # an entity is an object when some behaviour acts on one (chapter 5's moves act on the whole scene)
+        kind = "object" if any(b.get("target", "object") is not None for b in loaded.behaviors) else "scene"
         for e in preds:
-            where = ", ".join(f"{k} {v:.2f}" for k, v in e["features"].items())
-            t = Table(title=f"{'object' if where else 'scene'} {e['object']}" + (f": {where}" if where else ""),
-                      box=box.SIMPLE_HEAD)
+            shown = list(e["features"].items())
+            where = ", ".join(f"{k} {v:.2f}" for k, v in shown[:_TITLED]) + (", ..." if len(shown) > _TITLED else "")
+            t = Table(title=f"{kind} {e['object']}" + (f": {where}" if where else ""), box=box.SIMPLE_HEAD)
             cols = ["behaviour", "result" if given else "category", "p"]
+            if any("alpha" in p for p in e["behaviors"].values()):
+                cols.insert(1, "alpha")
             if not given:
-                cols += ["members were mostly", "seen after", "expected change"]
-            for col in cols:
-                t.add_column(col, no_wrap=True)
+                cols += ["members were mostly", "seen", "expected change"]
             if run_check:
-                t.add_column("in simulation", no_wrap=True)
+                cols.append("in simulation")
+            for col in cols:  # words wrap in a narrow terminal; numbers stay whole
+                t.add_column(col, no_wrap=col in ("behaviour", "alpha", "category", "p", "result"), overflow="fold")
             for name, p in e["behaviors"].items():
                 row = [name, p["result"] if given else str(p["category"]), f"{p['probability']:.2f}"]
+                if "alpha" in cols:
+                    row.insert(1, ", ".join(f"{a:.2f}" for a in p.get("alpha", ())) or "-")
                 if not given:
                     outcomes = cats[name][p["category"]].get("outcomes", {})
                     row += [max(outcomes, key=outcomes.get) if outcomes else "?", "yes" if p["next"]["visible"] else "no",

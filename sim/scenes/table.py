@@ -76,6 +76,7 @@ class TableScene:
     """The chapter 8 tabletop (see the module docstring for its task sheet)."""
 
     name = "table"
+    layout_format = "table"  # positions on the table top, x frontal, y lateral
     behaviors = TABLE_BEHAVIORS
     summary = "a hand pushes and lifts one random object on a table (thesis chapter 8)"
     labels = "discovered"
