@@ -18,6 +18,7 @@ feature bytes: a search meets the same object vector in many states.
 from __future__ import annotations
 
 import functools
+import threading
 from dataclasses import dataclass, field
 from itertools import product
 
@@ -45,6 +46,10 @@ def _blas():
     return ThreadpoolController()
 
 
+#: Whether this thread runs inside :func:`one_blas_thread` (nested calls skip the limit).
+_one_thread = threading.local()
+
+
 def one_blas_thread(fn):
     """Run ``fn`` with the BLAS libraries on one thread. Planning makes tens of thousands of
     small products (a few vectors against a classifier's support vectors or a category's
@@ -52,12 +57,19 @@ def one_blas_thread(fn):
     are busy it waits for one: on the table's planning benchmark (4 scenes, member effects),
     with both cores busy exploring, assessing the plans took 48.9 s on two BLAS threads and
     31.4 s on one; on an idle machine the two are alike (17-19 s, within the noise). The
-    limit costs about 10 microseconds and nests; it wraps the searches, execution, the
-    imagined rollouts and ``prefetch`` (where ``predict`` and ``evaluate`` enter)."""
+    limit costs about 10 microseconds (nothing inside another); it wraps the searches,
+    execution, the imagined rollouts, ``prefetch`` (where ``predict`` and ``evaluate``
+    enter) and the alpha choices a prefetch owes (made when first needed)."""
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        with _blas().limit(limits=1, user_api="blas"):
+        if getattr(_one_thread, "on", False):  # already limited by a caller
             return fn(*args, **kwargs)
+        with _blas().limit(limits=1, user_api="blas"):
+            _one_thread.on = True
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                _one_thread.on = False
 
     return wrapper
 
@@ -168,6 +180,12 @@ class ForwardModel:
         self.alpha_rule = alpha_rule
         self.alpha_grid = int(alpha_grid)
         self._choices: dict[tuple, list] = {}
+        # (behaviour, vector bytes) -> vector whose alpha choices a prefetch owes, made when
+        # first needed (:meth:`_settle`)
+        self._owed: dict[tuple[int, bytes], np.ndarray] = {}
+        self._columns: dict[tuple[int, tuple], tuple[BehaviorModel, np.ndarray]] = {}
+        self._rows: dict[tuple[int, tuple], tuple[BehaviorModel, np.ndarray]] = {}
+        self._grids: dict[tuple[int, int], tuple] = {}
         self.behaviors = behaviors
         self.effects = effects
         self.schema = schema
@@ -219,6 +237,15 @@ class ForwardModel:
         circle = circle and abs((hi - lo) - 360.0) < 1e-9
         return np.linspace(lo, hi, self.alpha_grid, endpoint=not circle)
 
+    def _grid(self, b: int) -> tuple[np.ndarray, tuple[tuple[float], ...]]:
+        """:meth:`choice_grid` and its points as parameter tuples, once per behaviour."""
+        key = (b, self.alpha_grid)
+        hit = self._grids.get(key)
+        if hit is None:
+            grid = self.choice_grid(b)
+            hit = self._grids[key] = (grid, tuple((float(a),) for a in grid))
+        return hit
+
     def choose_alphas(self, f: np.ndarray, b: int, rule: str | None = None) -> list[tuple[tuple[float, ...], int]]:
         """(alpha, the next state's category) for each next state behaviour ``b`` can bring
         entity ``f`` to, by ``rule`` (default: the model's ``alpha_rule``; see the class
@@ -227,12 +254,13 @@ class ForwardModel:
         if rule not in ("group", "probability"):
             raise DataError(f"choose_alphas needs the group or the probability rule, not {rule!r}")
         key = (b, f.tobytes(), rule)
+        if self._owed:
+            self._settle(b, key[1])
         hit = self._choices.get(key)
         if hit is not None:
             return hit
         model = self.behaviors[b]
-        grid = self.choice_grid(b)
-        alphas = [(float(a),) for a in grid]
+        grid, alphas = self._grid(b)
         classes, proba = self._predict_alphas(f, b, alphas)
         best = np.argmax(proba, axis=1)
         periodic = bool(model.periodic[0]) if len(model.periodic) else False
@@ -261,11 +289,15 @@ class ForwardModel:
         """(categories, P per alpha and category) for entity ``f`` under each of ``alphas``, in
         one batch; the results are cached as :meth:`distribution` keeps them."""
         model = self.behaviors[b]
-        cols = [self._alpha_columns(model, a) for a in alphas]
-        X = np.stack([np.concatenate([f[model.selected], a]) for a in cols])
+        A = self._alpha_rows(model, tuple(alphas))
+
+        def rows(selected):  # the entity's columns beside each alpha's (the same numbers as one row at a time)
+            return np.concatenate([np.broadcast_to(f[selected], (len(alphas), len(selected))), A], axis=1)
+
+        X = rows(model.selected)
         proba = self._proba(model.predictor)(X)
         if model.known is not None:
-            Xk = X if model.known_selected is None else np.stack([np.concatenate([f[model.known_selected], a]) for a in cols])
+            Xk = X if model.known_selected is None else rows(model.known_selected)
             proba = proba * self._proba(model.known)(Xk)[:, list(model.known.classes_).index(1)][:, None]
         classes = np.asarray(model.predictor.classes_, dtype=int)
         key = f.tobytes()
@@ -278,9 +310,26 @@ class ForwardModel:
         """(categories, probabilities) of behaviour ``b`` on entity vector ``f``."""
         alpha = () if alpha is None else alpha
         key = (b, f.tobytes(), alpha)
+        if self._owed:
+            self._settle(b, key[1])
         if key not in self._cache:
             self.prefetch([f], b, alpha)
         return self._cache[key]
+
+    def _settle(self, b: int, key: bytes) -> None:
+        """Make the alpha choices (and their predictions) a prefetch owes for behaviour ``b``
+        on the vector of bytes ``key``, if it owes them, exactly as the prefetch would have."""
+        v = self._owed.pop((b, key), None)
+        if v is not None:
+            self._choose_and_predict(v, b)
+
+    @one_blas_thread
+    def _choose_and_predict(self, v: np.ndarray, b: int) -> None:
+        """Behaviour ``b``'s alpha choices for ``v`` (one batch over the grid), then the chosen
+        alphas not predicted yet (grid means need their own predictions; one more batch)."""
+        chosen = [a for a in self.alpha_choices(v, b) if (b, v.tobytes(), a) not in self._cache]
+        if chosen:
+            self._predict_alphas(v, b, chosen)
 
     def _proba(self, predictor):
         """The predictor's fast probability function where it has one (same numbers)."""
@@ -292,11 +341,19 @@ class ForwardModel:
                                else predictor.predict_proba)
         return self._fast[key]
 
+    def _chosen(self, b: int, key: bytes) -> bool:
+        """Are behaviour ``b``'s alpha choices for the vector of bytes ``key``, and their
+        predictions, at hand?"""
+        chosen = self._choices.get((b, key, self.alpha_rule))
+        return chosen is not None and all((b, key, a) in self._cache for a, _ in chosen)
+
     def cached(self, f: np.ndarray) -> bool:
         """Are every behaviour's predictions for entity vector ``f`` at hand?"""
         key = f.tobytes()
         for b in range(len(self.behaviors)):
             if self._chooses(b):
+                if (b, key) in self._owed:
+                    continue  # made when first needed, as the prefetch that owes them would have
                 chosen = self._choices.get((b, key, self.alpha_rule))
                 if chosen is None:
                     return False
@@ -308,8 +365,26 @@ class ForwardModel:
         return True
 
     def _alpha_columns(self, model: BehaviorModel, alpha: tuple) -> np.ndarray:
-        specs = [{"periodic": bool(model.periodic[j]) if j < len(model.periodic) else False} for j in range(len(alpha))]
-        return encode_parameters(np.asarray(alpha, dtype=float), specs) if alpha else np.zeros(0)
+        """``alpha`` as the predictor's input columns (an angle as sine and cosine); cached,
+        read-only: a search encodes the same few alphas hundreds of thousands of times."""
+        key = (id(model), alpha)
+        hit = self._columns.get(key)
+        if hit is None or hit[0] is not model:
+            specs = [{"periodic": bool(model.periodic[j]) if j < len(model.periodic) else False} for j in range(len(alpha))]
+            cols = encode_parameters(np.asarray(alpha, dtype=float), specs) if alpha else np.zeros(0)
+            cols.setflags(write=False)
+            hit = self._columns[key] = (model, cols)
+        return hit[1]
+
+    def _alpha_rows(self, model: BehaviorModel, alphas: tuple) -> np.ndarray:
+        """:meth:`_alpha_columns` of each of ``alphas``, one row each; cached, read-only."""
+        key = (id(model), alphas)
+        hit = self._rows.get(key)
+        if hit is None or hit[0] is not model:
+            rows = np.stack([self._alpha_columns(model, a) for a in alphas])
+            rows.setflags(write=False)
+            hit = self._rows[key] = (model, rows)
+        return hit[1]
 
     @one_blas_thread
     def prefetch(self, vectors: list[np.ndarray], only: int | None = None, alpha_only: tuple | None = None) -> None:
@@ -323,14 +398,19 @@ class ForwardModel:
         for b, model in enumerate(self.behaviors):
             if only is not None and b != only:
                 continue
-            if self._chooses(b) and alpha_only is None:
-                # each vector's choice of alpha: one batch over the grid per vector, then the
-                # chosen alphas (grid means need their own predictions)
-                for v in fresh.values():
-                    chosen = [a for a in self.alpha_choices(v, b) if (b, v.tobytes(), a) not in self._cache]
-                    if chosen:
-                        self._predict_alphas(v, b, chosen)
-                continue
+            if self._chooses(b):
+                if alpha_only is None:
+                    # Each vector's choice of alpha costs a batch over the whole grid (36
+                    # rows), and most vectors a search meets are never expanded: the choice
+                    # is owed, and made when something first asks about the vector
+                    # (:meth:`_settle`), in the same batches as here, so with the same numbers
+                    # to the bit (a BLAS product's last bits depend on a row's place in its batch).
+                    for key, v in fresh.items():
+                        if (b, key) not in self._owed and not self._chosen(b, key):
+                            self._owed[(b, key)] = v.copy()  # not a view of a state someone may change
+                    continue
+                for key in fresh:
+                    self._settle(b, key)
             for alpha in self.alphas(b) if alpha_only is None else [alpha_only]:
                 todo = [v for key, v in fresh.items() if (b, key, alpha) not in self._cache]
                 if not todo:

@@ -19,6 +19,8 @@ robot leaves that object alone where it lies.
 
 from __future__ import annotations
 
+import time
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from typing import Callable, Protocol
 
@@ -27,7 +29,7 @@ import numpy as np
 from afford.plan.forward import ForwardModel, one_blas_thread
 from afford.plan.forward import SCENE
 from afford.plan.goals import Goal
-from afford.plan.search import UNREACHABLE, Plan, best_plans, search, situation
+from afford.plan.search import UNREACHABLE, Plan, best_plans, phase, search, situation, unwatched
 
 __all__ = ["World", "Execution", "assess", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
 
@@ -252,8 +254,17 @@ def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: 
 
 @one_blas_thread
 def _reach(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int, method: str,
-           rollouts: int, seed: int, imagined_nodes: int, budget: int, **limits) -> tuple[float, int]:
-    """:func:`reach_probability` and the number of rollouts it ran."""
+           rollouts: int, seed: int, imagined_nodes: int, budget: int, progress: Callable[[int], None] | None = None,
+           **limits) -> tuple[float, int]:
+    """:func:`reach_probability` and the number of rollouts it ran; ``progress(done)`` hears
+    each rollout end (the imagined replans' searches are not reported)."""
+    with unwatched():
+        return _rollouts(model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts,
+                         seed=seed, imagined_nodes=imagined_nodes, budget=budget, progress=progress, **limits)
+
+
+def _rollouts(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int, method: str,
+              rollouts: int, seed: int, imagined_nodes: int, budget: int, progress, **limits) -> tuple[float, int]:
     limits = {**limits, "max_nodes": min(limits.get("max_nodes", imagined_nodes), imagined_nodes)}
     if goal.holds(start):
         return 1.0, 0
@@ -278,24 +289,44 @@ def _reach(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, ma
         reached += execute(world, model, goal, method=method, max_replans=max_replans, first=plan,
                            planner=planner).reached
         done += 1
+        if progress is not None:
+            progress(done)
     return reached / done, done
 
 
 def assess(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int = 3,
            method: str = "best-first", rollouts: int = 100, seed: int = 0, imagined_nodes: int = 1000,
-           budget: int = 4000, **limits) -> Plan:
+           budget: int = 4000, progress: Callable[[int], None] | None = None, **limits) -> Plan:
     """Make ``plan.success_probability`` the chance of reaching the goal with monitoring
-    (:func:`reach_probability`).
+    (:func:`reach_probability`), and ``plan.assess_seconds`` the time that took.
 
     The open-loop figure stays in ``plan.open_loop_probability``; ``limits`` are the
-    search limits replanning would use.
+    search limits replanning would use; ``progress(done)`` hears each imagined run end.
+
+    The monitored figure may come out below the open-loop one, and that is no error: the
+    two ask different questions of the model. The open-loop walk moves an object by each
+    category's *mean* effect, so a goal the mean meets counts that category as reaching it
+    every time, while an imagined world draws each effect from one of the nearest members'
+    own (:meth:`ForwardModel.draw_effect`), some of which fall short. Measured on a grasp
+    model (300 interactions), one power grasp to raise the contact point by 95 % of its
+    lifted category's mean rise: open-loop 0.33, the same plan run blind in 400 imagined
+    worlds 0.115, monitored 0.26 (27 rollouts; 0.21 on 400). The open-loop walk also takes a
+    repeated step on an unchanged object as a fresh draw, where an imagined world keeps its
+    outcome (the world is not a die); the monitor leaves a plan at its first surprise,
+    where the blind run goes on and may still get there, to replan with searches capped at
+    ``imagined_nodes`` (one that would need more counts as failed), and gives up after
+    ``max_replans``. And the figure is a mean over as few as 20 rollouts once ``budget``
+    is spent (a standard error up to 0.11): on another scene the same goal gave 0.05 on 20
+    rollouts and 0.15 on 400, against 0.19 open-loop.
     """
     if plan.open_loop_probability is None:
         plan.open_loop_probability = plan.success_probability
     if plan.found:
+        t0 = time.perf_counter()
         plan.success_probability, plan.rollouts = _reach(
             model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts, seed=seed,
-            imagined_nodes=imagined_nodes, budget=budget, **limits)
+            imagined_nodes=imagined_nodes, budget=budget, progress=progress, **limits)
+        plan.assess_seconds = time.perf_counter() - t0
     plan.replans_assumed = max_replans
     return plan
 
@@ -317,9 +348,17 @@ def rank_plans(model: ForwardModel, start: np.ndarray, goal: Goal, candidates: i
         plans = best_plans(model, start, goal, max(1, candidates), avoid=avoid, held=held, **limits)
     else:
         plans = [search(model, start, goal, method, avoid=avoid, held=held, **limits)]
-    for plan in plans:
-        assess(model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts, seed=seed,
-               imagined_nodes=imagined_nodes, budget=budget, **limits)
+    found = sum(p.found for p in plans)
+    with (phase(f"assessing {found} plan{'s' * (found != 1)} (imagined runs)", found * rollouts) if found
+          else nullcontext(lambda done: None)) as tick:
+        done = 0  # imagined runs of the plans assessed so far, each counted in full
+        for plan in plans:
+            assess(model, start, goal, plan, max_replans=max_replans, method=method, rollouts=rollouts, seed=seed,
+                   imagined_nodes=imagined_nodes, budget=budget, progress=lambda k, done=done: tick(done + k),
+                   **limits)
+            if plan.found:
+                done += rollouts
+                tick(done)  # a budget that ran out ends the plan's share early
     return sorted(plans, key=lambda p: (-p.success_probability, -p.path_probability))
 
 

@@ -21,6 +21,8 @@ from __future__ import annotations
 import heapq
 import math
 import time
+from contextlib import contextmanager, nullcontext
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,7 +30,8 @@ import numpy as np
 from afford.plan.forward import SCENE, ForwardModel, one_blas_thread
 from afford.plan.goals import Goal
 
-__all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query", "SAME_PLACE", "UNREACHABLE"]
+__all__ = ["PlanStep", "Plan", "best_first", "best_plans", "breadth_first", "success_probability", "search", "inverse_query",
+           "watching", "unwatched", "phase", "SAME_PLACE", "UNREACHABLE"]
 
 
 @dataclass(frozen=True)
@@ -59,6 +62,7 @@ class Plan:
     open_loop_probability: float | None = None  # set with success_probability by the search
     replans_assumed: int = 0  # success_probability assumes monitoring with this many replans
     rollouts: int = 0  # imagined executions behind success_probability (0: open-loop figure)
+    assess_seconds: float = 0.0  # time those imagined executions took (``seconds`` is the search's)
 
     def to_json(self) -> dict:
         open_loop = self.success_probability if self.open_loop_probability is None else self.open_loop_probability
@@ -68,7 +72,50 @@ class Plan:
                 "open_loop_probability": round(open_loop, 4), "replans_assumed": self.replans_assumed,
                 "rollouts": self.rollouts,
                 "expanded": self.expanded, "generated": self.generated, "seconds": round(self.seconds, 4),
-                "reason": self.reason}
+                "assess_seconds": round(self.assess_seconds, 4), "reason": self.reason}
+
+
+#: Who hears how far a search or an assessment has got (:func:`watching`); None: nobody.
+_WATCH: ContextVar = ContextVar("afford_plan_watch", default=None)
+
+
+@contextmanager
+def watching(progress):
+    """Report the progress of the searches and assessments run inside the block.
+
+    ``progress(description, total)`` is called as a search starts (``total``: its node
+    budget; the search may end well before it) and as :func:`plan.monitor.rank_plans`
+    starts assessing its candidates (``total``: their imagined runs); it returns a context
+    manager that yields ``update(done)``, and is left when that work ends. The searches
+    the imagined runs replan with are not reported (they are the assessment's work).
+    """
+    token = _WATCH.set(progress)
+    try:
+        yield
+    finally:
+        _WATCH.reset(token)
+
+
+@contextmanager
+def unwatched():
+    """Within the block, searches and assessments report to nobody (an assessment's own
+    imagined replans are its work, not searches of their own)."""
+    token = _WATCH.set(None)
+    try:
+        yield
+    finally:
+        _WATCH.reset(token)
+
+
+def phase(description: str, total: int):
+    """A context manager yielding ``update(done)`` for work that :func:`watching` reports
+    (one that ignores it elsewhere)."""
+    watch = _WATCH.get()
+    return nullcontext(_ignore) if watch is None else watch(description, total)
+
+
+def _ignore(done: int) -> None:
+    pass
 
 
 def _key(state: np.ndarray, held: int = -1) -> bytes:
@@ -228,9 +275,17 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
     one plan that says why; otherwise only found plans are returned. Each plan's search
     effort counts everything expanded up to it.
     """
-    t0 = time.perf_counter()
     if goal.holds(start):
-        return [Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")]
+        return [Plan(True, [], 1.0, 1.0, 0, 0, 0.0, "the goal holds already")]
+    with phase("searching (nodes expanded / budget)", max_nodes) as tick:
+        return _best_plans(model, start, goal, n_plans, max_depth, max_nodes, heuristic_weight, avoid, held,
+                           open_loop, tick)
+
+
+def _best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int, max_depth: int, max_nodes: int,
+                heuristic_weight: float, avoid: tuple, held: int, open_loop: bool, tick) -> list[Plan]:
+    """:func:`best_plans`; ``tick(expanded)`` hears each expansion."""
+    t0 = time.perf_counter()
     found: list[Plan] = []
     sequences: set[tuple] = set()
     counter = 0
@@ -261,6 +316,7 @@ def best_plans(model: ForwardModel, start: np.ndarray, goal: Goal, n_plans: int,
             return found or [Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                                   f"node budget of {max_nodes} expansions spent", tree)]
         expanded += 1
+        tick(expanded)
         # Predictions wait until a node needs them, then come for every vector met so far
         # in one batch per behaviour: scikit-learn's per-call overhead, not the rows, is
         # what a planning search pays for.
@@ -307,9 +363,16 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                   max_nodes: int = 20000, avoid: tuple = (), held: int = -1, open_loop: bool = True) -> Plan:
     """Forward chaining over each behaviour's most probable outcome (thesis chapter 7).
     ``open_loop``: as for :func:`best_first`."""
-    t0 = time.perf_counter()
     if goal.holds(start):
-        return Plan(True, [], 1.0, 1.0, 0, 0, time.perf_counter() - t0, "the goal holds already")
+        return Plan(True, [], 1.0, 1.0, 0, 0, 0.0, "the goal holds already")
+    with phase("searching (nodes expanded / budget)", max_nodes) as tick:
+        return _breadth_first(model, start, goal, max_depth, max_nodes, avoid, held, open_loop, tick)
+
+
+def _breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, max_depth: int, max_nodes: int, avoid: tuple,
+                   held: int, open_loop: bool, tick) -> Plan:
+    """:func:`breadth_first`; ``tick(expanded)`` hears each expansion."""
+    t0 = time.perf_counter()
     level = [(start, (), held)]
     seen = {_key(start, held)}
     expanded = generated = 0
@@ -320,6 +383,7 @@ def breadth_first(model: ForwardModel, start: np.ndarray, goal: Goal, *, max_dep
                 return Plan(False, [], 0.0, 0.0, expanded, generated, time.perf_counter() - t0,
                             f"node budget of {max_nodes} expansions spent")
             expanded += 1
+            tick(expanded)
             for b, obj, alpha in _actions(model, state, goal, held):
                 if avoid and _distrust(avoid, state, model.names[b], obj, held, model) >= 2 * DISTRUST:
                     continue  # chaining has no costs: a step that failed here is simply not retried

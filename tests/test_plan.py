@@ -470,3 +470,152 @@ def test_planning_runs_blas_on_one_thread_and_gives_the_threads_back():
     seen = one_blas_thread(blas_threads)()
     assert seen == {1}
     assert blas_threads() == before
+
+
+class Aimed:
+    """A push's outcome by where it is aimed (its last two columns: alpha's sine and cosine)
+    and where the object stands (its first): near 20 degrees it moves the object 10 cm, a
+    little off 5 cm, elsewhere not at all. Like a BLAS product, the last bits of a row's
+    numbers depend on its place in its batch (the rows past the last multiple of four)."""
+
+    def __init__(self):
+        self.classes_ = np.arange(3)
+        self.batches: list[int] = []
+
+    def predict_proba(self, X):
+        self.batches.append(len(X))
+        a = np.degrees(np.arctan2(X[:, -2], X[:, -1]))
+        off = np.abs(a - 20.0)
+        far = 1.0 - np.clip(X[:, 0], 0.0, 0.5)  # the further out, the less it goes
+        ten = np.where(off < 25.0, 0.75 * far, 0.05)
+        five = np.where(off < 50.0, 0.2, 0.1)
+        p = np.column_stack([ten, five, 1.0 - ten - five])
+        tail = np.arange(len(X)) >= len(X) - len(X) % 4
+        return p * (1.0 - 1e-13 * tail)[:, None]
+
+
+def aimed(name, far, near):
+    """A behaviour of one angle (an :class:`Aimed` predictor) whose outcomes move the object
+    by ``far`` or ``near`` (dx, dy), or not at all."""
+    def moved(dx, dy):
+        e = effect(dx)
+        e[SCHEMA.index("y_min")] = e[SCHEMA.index("y_max")] = dy
+        return e
+
+    return BehaviorModel(name, Aimed(), np.array([X_MIN]), np.stack([moved(*far), moved(*near), effect()]),
+                         parameters=[(-90.0, 90.0)], periodic=(True,))
+
+
+def aiming(cls=ForwardModel):
+    """Two aimed pushes that move an object along different ways: a search meets many vectors."""
+    return cls([aimed("aim", (0.1, 0.03), (0.05, -0.04)), aimed("swing", (0.08, -0.01), (0.02, 0.05))], SCHEMA,
+               alpha_rule="group")
+
+
+class Eager(ForwardModel):
+    """The forward model as it was: every vector a prefetch meets gets its alpha choice at once."""
+
+    def prefetch(self, vectors, only=None, alpha_only=None):
+        super().prefetch(vectors, only, alpha_only)
+        for b, key in list(self._owed):
+            self._settle(b, key)
+
+
+def test_alpha_choices_are_made_for_the_vectors_a_search_expands_with_the_same_numbers():
+    g = goal("0:x_min=0.3~0.02")
+    lazy = aiming()
+    plan = best_first(lazy, scene(0.0), g, open_loop=False)
+    assert plan.found and len(plan.steps) == 3
+
+    def grids(fm):  # batches over the 36-point grid of alphas
+        return sum(n == fm.alpha_grid for b in fm.behaviors for n in b.predictor.batches)
+
+    # one batch per behaviour and vector the search expanded, not per vector it met
+    assert grids(lazy) <= 2 * plan.expanded
+    eager = aiming(Eager)
+    assert best_first(eager, scene(0.0), g, open_loop=False).expanded == plan.expanded
+    assert grids(eager) > 2 * grids(lazy)
+    # ranked and assessed, the plans are the same to the bit: every batch is as it was
+    lazy, eager = aiming(), aiming(Eager)
+    a, b = (rank_plans(fm, scene(0.0), g, 3, rollouts=40) for fm in (lazy, eager))
+    assert len(a) == len(b) == 3
+
+    def bits(p):
+        return ([(s.behavior, s.obj, s.alpha, s.category, s.probability, s.predicted.tobytes()) for s in p.steps],
+                p.path_probability, p.success_probability, p.open_loop_probability, p.rollouts)
+
+    assert [bits(p) for p in a] == [bits(p) for p in b]
+    assert grids(lazy) < grids(eager)
+    shared = [k for k in lazy._cache if k in eager._cache]
+    assert shared and all(lazy._cache[k][1].tobytes() == eager._cache[k][1].tobytes() for k in shared)
+
+
+def test_a_ranking_reports_its_search_and_assessment_as_they_go_and_times_both():
+    from contextlib import contextmanager
+
+    from afford.plan.search import watching
+
+    events = []
+
+    @contextmanager
+    def progress(description, total):
+        seen: list[int] = []
+        events.append((description, total, seen))
+        yield seen.append
+
+    fm = aiming()
+    g = goal("0:x_min=0.3~0.02")
+    with watching(progress):
+        ranked = rank_plans(fm, scene(0.0), g, 2, rollouts=30, max_nodes=500)
+    # the imagined runs replan (a push falls short), yet their searches are the
+    # assessment's work, not searches of their own
+    assert [d.split()[0] for d, _, _ in events] == ["searching", "assessing"]
+    (_, budget, nodes), (what, total, runs) = events
+    assert budget == 500 and nodes == list(range(1, len(nodes) + 1)) and len(nodes) >= max(p.expanded for p in ranked)
+    assert what.startswith("assessing 2 plans") and total == 60
+    assert runs == sorted(runs) and runs[-1] == 60
+    assert all(p.assess_seconds > 0 and p.to_json()["assess_seconds"] == round(p.assess_seconds, 4) for p in ranked)
+    assert all(p.rollouts == 30 for p in ranked)
+    # nobody listens outside the block
+    events.clear()
+    rank_plans(fm, scene(0.0), g, 2, rollouts=30)
+    assert events == []
+
+
+def test_one_plan_in_json_says_whether_it_was_found_and_nothing_reached_when_nothing_ran(pipeline):
+    import json
+
+    from tests.clitools import ok
+
+    model = str(pipeline / "model.afford")
+    args = ["plan", model, "--seed", "3", "--reachable", "--max-depth", "1", "--alternatives", "1", "--json"]
+    out = json.loads(ok(args + ["--goal", "*:visibility=0"]).stdout)
+    assert out["found"] is True and out["plan"]["found"] is True  # the plan's verdict, not a count of scenes
+    assert out["success_probability"] == out["plan"]["success_probability"]
+    assert out["reached"] is None and out["replans"] is None  # nothing ran
+    assert [v["reached"] for v in out["by_length"].values()] == [None]
+    assert out["planning_seconds"] == pytest.approx(out["search_seconds"] + out["assess_seconds"], abs=2e-4)
+    assert out["assess_seconds"] == out["plan"]["assess_seconds"] > 0
+    none = json.loads(ok(args + ["--goal", "0:x_min=5~0.01"]).stdout)
+    assert none["found"] is False and none["reason"] == none["plan"]["reason"] and none["by_length"] == {}
+    episodes = json.loads(ok(args + ["--goal", "*:visibility=0", "--episodes", "2"]).stdout)
+    assert episodes["found"] == sum(v["found"] for v in episodes["by_length"].values())  # a count, over scenes
+    assert all(v["reached"] is None for v in episodes["by_length"].values()) and "reached" not in episodes
+
+
+def test_slow_searches_and_assessments_show_a_bar_on_stderr_and_quick_ones_do_not(capsys):
+    from afford.output import Output
+    from afford.planning import progress_bars
+    from afford.plan.search import watching
+
+    g = goal("0:x_min=0.3~0.02")
+    with watching(progress_bars(Output(), after=0.0)):  # everything is slow
+        rank_plans(aiming(), scene(0.0), g, 2, rollouts=30, max_nodes=500)
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    lines = [ln for ln in captured.err.splitlines() if ln.strip()]
+    assert len(lines) == 2 and lines[0].startswith("searching") and lines[1].startswith("assessing 2 plans")
+    assert "60/60" in lines[1]
+    with watching(progress_bars(Output())):  # nothing here takes seconds
+        rank_plans(aiming(), scene(0.0), g, 2, rollouts=30, max_nodes=500)
+    assert capsys.readouterr().err == ""

@@ -19,7 +19,7 @@ from afford.options import (
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
 from afford.api import parse_goal
-from afford.planning import plan_once
+from afford.planning import plan_once, progress_bars
 from afford.scenes_io import make_scene, scene_layout
 from afford.plan.report import summarise
 
@@ -40,10 +40,16 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
     p = entry["plan"]
     console.print(f"goal: {' and '.join(goal_text)}")
     if not p["found"]:
-        console.print(f"[red]no plan[/]: {p['reason']} ({p['expanded']} nodes expanded, {p['seconds']:.2f} s)")
+        console.print(f"[red]no plan[/]: {p['reason']} ({p['expanded']} nodes expanded, "
+                      f"{entry.get('planning_seconds', p['seconds']):.2f} s)")
         return
-    console.print(f"plan: {p['length']} step{'s' if p['length'] != 1 else ''} "
-                  f"({p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms); success probability "
+    if "planning_seconds" in entry:  # the search and the candidates' assessment
+        n = 1 + len(entry.get("alternatives", []))
+        effort = (f"{p['expanded']} nodes expanded; {entry['planning_seconds']:.2f} s: searching "
+                  f"{entry['search_seconds']:.2f} s, assessing {n} candidate{'s' * (n != 1)} {entry['assess_seconds']:.2f} s")
+    else:
+        effort = f"{p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms searching"
+    console.print(f"plan: {p['length']} step{'s' if p['length'] != 1 else ''} ({effort}); success probability "
                   f"{p['success_probability']:.2f} with monitoring and up to {p['replans_assumed']} replans, "
                   f"{p['open_loop_probability']:.2f} run blind")
     table = Table(box=box.SIMPLE_HEAD)
@@ -114,7 +120,7 @@ def plan(
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable, button=button)
         entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives,
-                                 say=out.info if execute else None, plot=plot))
+                                 say=out.info if execute else None, plot=plot, progress=progress_bars(out)))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
@@ -126,9 +132,14 @@ def plan(
                                     "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})
                 update(e + 1)
     result = summarise(entries, execute)
+    if not execute:  # nothing ran: nothing was reached, nor missed
+        for v in result["by_length"].values():
+            v["reached"] = None
+    planned = [e for e in entries if "skipped" not in e]
+    result["mean_planning_seconds"] = round(sum(e["planning_seconds"] for e in planned) / max(1, len(planned)), 4)
     result["goal"] = g.to_json()
     if episodes == 1:
-        result.update(entries[0])
+        result.update(single_plan(entries[0], execute))
 
     def render(console):
         if episodes == 1:
@@ -137,6 +148,23 @@ def plan(
             render_summary(console, result)
 
     out.result(result, render)
+
+
+def single_plan(entry: dict, execute: bool) -> dict:
+    """The top-level keys of one plan's ``--json``, as ``emulate`` gives them: ``found`` (a
+    bool), ``reason`` when no plan was found, the success probabilities, and ``reached`` and
+    ``replans`` (null when nothing ran: no ``--execute``; false and 0 when no plan was found
+    to run). The episodes summary's keys stay beside them, counted over this one scene."""
+    p = entry["plan"]
+    out = {"found": bool(p["found"]), "success_probability": p["success_probability"],
+           "open_loop_probability": p["open_loop_probability"],
+           "reached": False if execute else None, "replans": 0 if execute else None}
+    if execute:
+        out["first_plan_worked"] = False
+    if not p["found"]:
+        out["reason"] = p["reason"]
+    out.update(entry)
+    return out
 
 
 def render_summary(console, result: dict) -> None:
@@ -155,4 +183,5 @@ def render_summary(console, result: dict) -> None:
                       f"run blind {result['mean_open_loop_probability']:.2f}"
                       + (f" (first plans that worked without replanning: {result['first_plan_worked']} of {result['found']})"
                          if "first_plan_worked" in result else ""))
-    console.print(f"mean search: {result['mean_expanded']:.0f} nodes, {1000 * result['mean_seconds']:.0f} ms")
+    console.print(f"mean search: {result['mean_expanded']:.0f} nodes, {1000 * result['mean_seconds']:.0f} ms; "
+                  f"with the candidates' assessment {result['mean_planning_seconds']:.2f} s")
