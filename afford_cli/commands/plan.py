@@ -14,13 +14,13 @@ from afford.features.errors import DataError
 from afford.learning import load_model
 from afford.options import (
     AlphaRule, AlphaRuleOpt, EffectModel, Effects,
-    Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, Objects, SceneName, SceneSeed, check_scene_source,
+    Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, ModelScene, Objects, SceneSeed, check_scene_source,
 )
 from afford.output import Output
 from afford.plots import PlotFile, check_plot_file
 from afford.api import parse_goal
 from afford.planning import plan_once, progress_bars
-from afford.scenes_io import make_scene, scene_layout
+from afford.scenes_io import model_scene, scene_layout
 from afford.plan.report import summarise
 
 
@@ -82,7 +82,7 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
 def plan(
     model: Annotated[str, typer.Argument(help="A model artefact.", metavar="MODEL")],
     goal: Annotated[list[str], typer.Option("--goal", help="OBJ:FEATURE=VALUE~RANGE; repeat for several (all must hold).")],
-    scene: SceneName = "table",
+    scene: ModelScene = None,
     seed: SceneSeed = None,
     objects: Objects = None,
     layout: Layout = None,
@@ -116,7 +116,7 @@ def plan(
     base = seed or 0
     entries = []
     # a scene the model cannot perceive is refused once, not skipped episode by episode
-    loaded.check_schema(make_scene(scene).schema, "this scene's perception")
+    scene = model_scene(loaded, scene)
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable, button=button)
         entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives,
