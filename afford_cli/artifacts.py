@@ -38,7 +38,7 @@ from afford.errors import AffordError
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
-    "artifact_bytes", "dump_estimator", "load_estimator", "check_output", "writes_stdout", "output_is_file",
+    "artifact_bytes", "dump_estimator", "load_estimator", "check_output", "check_not_input", "writes_stdout", "output_is_file",
 ]
 
 FORMAT = "afford"
@@ -374,9 +374,36 @@ def output_is_file(path: str) -> bool:
     return path != "-" and not writes_stdout(path) and _target(path)[0] == "file"
 
 
-def check_output(path: str) -> None:
+def _same_file(a: str, b: str) -> bool:
+    """Are output ``a`` and input ``b`` one existing file (a link, ``./x`` or a hard link to
+    it too)? Input ``-`` is standard input: the same file when a shell redirected it from ``a``."""
+    if a == "-" or not a or not b:
+        return False
+    if b == "-":
+        try:
+            here, there = os.fstat(sys.stdin.fileno()), os.stat(a)
+        except (OSError, ValueError, AttributeError):
+            return False
+        return stat.S_ISREG(here.st_mode) and (here.st_dev, here.st_ino) == (there.st_dev, there.st_ino)
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return os.path.realpath(a) == os.path.realpath(b)
+
+
+def check_not_input(path: str, inputs=()) -> None:
+    """Refuse output ``path`` when it is one of the command's ``inputs``: writing it would
+    destroy what is being read (checked before any work)."""
+    for source in inputs or ():
+        if _same_file(path, str(source)):
+            raise AffordError(f"{path} is an input of this command; give another output path")
+
+
+def check_output(path: str, inputs=()) -> None:
     """Fail before any work if ``path`` cannot take the output (``-`` always can, unless it
-    is a terminal and the output is an artefact)."""
+    is a terminal and the output is an artefact), or if it is one of ``inputs``, the paths
+    the command reads."""
+    check_not_input(path, inputs)
     if path == "-" or writes_stdout(path):
         if sys.stdout.isatty():
             raise AffordError("refusing to write an artefact to the terminal; give -o FILE or pipe it on")

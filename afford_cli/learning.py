@@ -92,10 +92,20 @@ def read_effects(art: Artifact, data: Interactions) -> tuple[np.ndarray, dict | 
         with reading(art):
             models = {name: art.estimator(_blob_name("effects", name), TRUSTED, EffectCategories, EFFECT_PARTS)
                       for name in data.behavior_names}
-            labels = art.arrays["category"].astype(int)
+            raw = art.arrays["category"]
+            if raw.dtype.kind not in "iu":
+                raise AffordError(f"{art.source}: category holds {raw.dtype} values where whole category numbers "
+                                  "belong; it is corrupt or was edited")
+            labels = raw.astype(int)
             if labels.shape != (len(data),) or (labels.size and (labels.min() < -1 or labels.max() >= 10_000)):
                 raise AffordError(f"{art.source}: category does not give one category per interaction; "
                                   "it is corrupt or was edited")
+            for b, name in enumerate(data.behavior_names):
+                n = int(models[name].n_categories_)
+                mine = labels[data.behavior == b]
+                if mine.size and mine.max() >= n:
+                    raise AffordError(f"{art.source}: category gives {name} category {int(mine.max())}, but {name} "
+                                      f"has {n} (0-{n - 1}, -1 for a dropped row); it is corrupt or was edited")
         return labels, models
     if data.result is not None:
         return data.result.astype(int), None
@@ -126,8 +136,11 @@ def read_selection(art: Artifact, data: Interactions) -> dict[str, np.ndarray]:
         d = len(data.schema)
         out = {}
         with reading(art):
-            for name in data.behavior_names:
+            for b, name in enumerate(data.behavior_names):
                 out[name] = _feature_indices(art, f"selected.{name}", d)
+                if out[name].size == 0 and not data.behaviors[b].get("parameters"):
+                    # the predictor would have no input at all
+                    raise AffordError(f"{art.source}: selected.{name} is empty; it is corrupt or was edited")
         return out
     return {name: np.arange(len(data.schema)) for name in data.behavior_names}
 
@@ -321,6 +334,11 @@ class LoadedModel:
             if cats is not None and len(cats) != expected:
                 raise AffordError(f"{art.source} is corrupt or was edited: its manifest lists {len(cats)} categories "
                                   f"of {n}, its arrays {expected}")
+        for key, a in sorted(art.arrays.items()):
+            if (key.startswith("prototypes.") or key.startswith("members_")) and a.dtype.kind == "f" \
+                    and not np.isfinite(a).all():
+                raise AffordError(f"{art.source}: {key} holds values that are not finite numbers (NaN or "
+                                  "infinity); it is corrupt or was edited")
         self.members = {n: self._members(art, n) for n in self.names}
 
     def _members(self, art: Artifact, name: str):

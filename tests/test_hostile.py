@@ -372,3 +372,89 @@ def test_a_relabelled_schema_1_file_is_refused_and_a_real_one_is_unsealed(pipeli
         m.update(schema_version=1), *(m.pop(k, None) for k in ("label_source", "result_names", "n_entities"))])
     art = read_artifact(str(old))
     assert not art.sealed
+
+
+# -- an output that is one of the command's inputs: refused before any work ------------------
+
+@pytest.mark.parametrize("cmd, src, out", [
+    (["export", "{x}", "-o", "{x}"], "train.afford", "same"),
+    (["export", "{x}", "-o", "{x}", "-f", "parquet"], "train.afford", "same"),
+    (["train", "{x}", "-o", "{dot}"], "features.afford", "same"),
+    (["cluster", "{x}", "-o", "{x}"], "train.afford", "same"),
+    (["select-features", "{x}", "-o", "{x}"], "effects.afford", "same"),
+    (["merge", "{x}", "-o", "{x}"], "train.afford", "same"),
+    (["train", "{link}", "-o", "{x}"], "features.afford", "link"),
+    (["export", "{x}", "-o", "{hard}"], "train.afford", "hard"),
+])
+def test_an_output_that_is_an_input_is_refused_before_any_work(pipeline, tmp_path, monkeypatch, cmd, src, out):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    monkeypatch.chdir(tmp_path)
+    x = tmp_path / src
+    shutil.copy(pipeline / src, x)
+    (tmp_path / "link.afford").symlink_to(src)
+    os.link(x, tmp_path / "hard.afford")
+    before = x.read_bytes()
+    listing = sorted(p.name for p in tmp_path.iterdir())
+    args = [a.format(x=src, dot=f"./{src}", link="link.afford", hard="hard.afford") for a in cmd]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 1, (args, result.output)
+    assert isinstance(result.exception, SystemExit)
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and "is an input of this command; give another output path" in errors[0], result.output
+    assert x.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == listing
+
+
+# -- forged learning files the chain used to take (checksums recomputed) ---------------------
+
+def _shifted_categories(p: Path, shift=50, as_float=False):
+    import numpy as np
+
+    from afford.artifacts import read_artifact
+
+    cat = read_artifact(str(p / "effects.afford")).arrays["category"].astype(np.int16)
+    cat = np.where(cat >= 0, cat + shift, cat)
+    return _npy(cat.astype(np.float32) if as_float else cat)
+
+
+def _non_finite(p: Path, member: str, value: float):
+    import numpy as np
+
+    from afford.artifacts import read_artifact
+
+    a = read_artifact(str(p / "model.afford")).arrays[member].copy()
+    a.flat[0] = value
+    return _npy(a)
+
+
+@pytest.mark.parametrize("case, src, members, cmd, message", [
+    ("selected-empty", "features.afford", lambda p: {"selected.push-forward.npy": _npy(__import__("numpy").zeros(0, "int32"))},
+     ["train", "-o", "{out}"], "selected.push-forward is empty; it is corrupt or was edited"),
+    ("categories-shifted", "effects.afford", lambda p: {"category.npy": _shifted_categories(p)},
+     ["train", "-o", "{out}"], "category gives"),
+    ("categories-float", "effects.afford", lambda p: {"category.npy": _shifted_categories(p, 0, True)},
+     ["train", "-o", "{out}"], "where whole category numbers belong"),
+    ("categories-shifted-select", "effects.afford", lambda p: {"category.npy": _shifted_categories(p)},
+     ["select-features", "-o", "{out}"], "category gives"),
+    ("prototypes-nan", "model.afford", lambda p: {"prototypes.lift.npy": _non_finite(p, "prototypes.lift", float("nan"))},
+     ["predict", "--seed", "1"], "prototypes.lift holds values that are not finite"),
+    ("members-inf", "model.afford", lambda p: {"members_E.lift.npy": _non_finite(p, "members_E.lift", float("inf"))},
+     ["predict", "--seed", "1"], "members_E.lift holds values that are not finite"),
+])
+def test_a_forged_learning_file_is_refused_when_read(pipeline, tmp_path, case, src, members, cmd, message):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    path = forge(pipeline / src, tmp_path / f"{case}.afford", members(pipeline))
+    before = path.read_bytes()
+    args = [cmd[0], str(path)] + [a.format(out=tmp_path / "o.afford") for a in cmd[1:]]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 1, (case, result.output, result.exception)
+    assert isinstance(result.exception, SystemExit), f"{case}: {result.exception!r}"
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and str(path) in errors[0] and message in errors[0], (case, result.output)
+    assert path.read_bytes() == before and not (tmp_path / "o.afford").exists()

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from enum import Enum
 from typing import Annotated, Optional
 
 import typer
 
 from afford.artifacts import check_output, writes_stdout
+from afford.errors import AffordError
+from afford.features.errors import DataError
 from afford.options import InputPath, Json, OutputPath, Seed
 from afford.output import Output
 
@@ -39,6 +42,19 @@ def parse_k(values: list[str] | None) -> dict[str, int] | None:
     return out
 
 
+@contextmanager
+def _cli_wording(prune: "Prune"):
+    """The learner's advice in the command line's words (its options, not Python names)."""
+    try:
+        yield
+    except DataError as exc:
+        if "survived pruning" not in str(exc):
+            raise
+        advice = ("lower --min-fraction" if prune is Prune.frequency else
+                  "cluster with --prune frequency (the features told no category apart well enough)")
+        raise AffordError(f"no effect category survived pruning; {advice}, or collect more interactions") from None
+
+
 def cluster(
     path: InputPath,
     output: OutputPath,
@@ -57,9 +73,9 @@ def cluster(
     ks = parse_k(k)
     if ks is not None and method is Method.hierarchical:
         raise typer.BadParameter("--k goes with --method kmeans")
-    check_output(output)
+    check_output(output, [path])
     out = Output(json, stdout_busy=writes_stdout(output))
-    with out.progress("clustering effects (behaviours)", None, lazy=True) as update:
+    with out.progress("clustering effects (behaviours)", None, lazy=True) as update, _cli_wording(prune):
         result = run(path, output, method=None if method is None else method.value, k_max=kmax, k=ks, prune=prune.value,
                      min_fraction=min_fraction, seed=seed, progress=update,
                      channels=None if channels is None else [c.strip() for c in channels.split(",") if c.strip()])
@@ -67,8 +83,11 @@ def cluster(
     def render(console):
         from afford.reports import render_categories
 
+        why = "rare kinds" if prune is Prune.frequency else "unpredictable kinds"
         for name, s in result["behaviors"].items():
             render_categories(console, name, s["categories"], [(ch, names) for ch, names in result["channels"]])
+            total = s["pruned_rows"] + sum(int(c["count"]) for c in s["categories"])
+            console.print(f"{name}: {s['pruned_rows']} of {total} interactions dropped ({why})")
         console.print(f"-> {output} ({result['seconds']:.1f} s)")
 
     out.result(result, render)

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from afford.artifacts import check_output, write_artifact, writes_stdout
+from afford.artifacts import check_not_input, check_output, write_artifact, writes_stdout
 from afford.options import InputPath, Json
 from afford.output import Output
 
@@ -22,6 +22,7 @@ def export(
 
     fmt = format_for(output, format)
     check_extras(fmt)
+    check_not_input(output, [path])
     if not (output == "-" and fmt == "csv"):  # CSV is text: the terminal may have it
         check_output(output)
     frame = to_frame(path)

@@ -18,10 +18,11 @@ def merge(
     """Join shards of one exploration (same scene, schema and seed; episodes neither overlapping
     nor missing) into the interactions a one-shot run gives."""
     from afford.api import merge as run
-    from afford.artifacts import writes_stdout
+    from afford.artifacts import check_output, writes_stdout
 
+    check_output(output, paths)
     result = run(paths, output)
     Output(json, stdout_busy=writes_stdout(output)).result(
         result, lambda console: console.print(
-            f"merged {result['shards']} shards: {result['interactions']} interactions of episodes "
+            f"merged {result['shards']} shard{'' if result['shards'] == 1 else 's'}: {result['interactions']} interactions of episodes "
             f"{result['episodes'][0]}-{result['episodes'][1] - 1} (seed {result['seed']}) -> {output}"))

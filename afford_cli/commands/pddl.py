@@ -19,14 +19,32 @@ from afford.scenes_io import model_scene, open_world, scene_layout
 FILES = ("domain.pddl", "problem.pddl", "domain.ppddl", "problem.ppddl")
 
 
-def _out_dir(path: str) -> Path:
+def _check_out_dir(path: str) -> Path:
+    """The directory for the PDDL files, checked before any work (not yet made)."""
+    import os
+
+    if path == "-":
+        raise AffordError("pddl writes four files, not one stream; give a directory (-o DIR), not '-'")
+    if not path:
+        raise AffordError("give a directory for the PDDL files (-o DIR)")
     out = Path(path)
     if out.exists() and not out.is_dir():
         raise AffordError(f"{path} is a file; give a directory for the PDDL files")
+    where = out if out.exists() else (out.parent if str(out.parent) else Path("."))
+    if not out.exists() and not where.is_dir():
+        raise AffordError(f"cannot write {path}: {out.parent} does not exist")
+    if not os.access(where, os.W_OK | os.X_OK):
+        raise AffordError(f"cannot write {path}: permission denied")
+    return out
+
+
+def _out_dir(path: str) -> Path:
+    out = _check_out_dir(path)
     if not out.exists():
-        if not (out.parent if str(out.parent) else Path(".")).is_dir():
-            raise AffordError(f"cannot write {path}: {out.parent} does not exist")
-        out.mkdir()
+        try:
+            out.mkdir()
+        except OSError as exc:
+            raise AffordError(f"cannot write {path}: {exc.strerror.lower() if exc.strerror else exc}") from None
     return out
 
 
@@ -48,6 +66,7 @@ def pddl(
     from afford.plan.pddl import build_task
 
     check_scene_source(layout, seed, objects=objects)
+    _check_out_dir(output)
     solve = solve or execute
     if solve:
         from afford.solvers import check_solver

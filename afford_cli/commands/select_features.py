@@ -38,7 +38,7 @@ def select_features(
     """Rank the entity features by relevance to each behaviour's labels (effect categories, or given results)."""
     from afford.api import select_features as run
 
-    check_output(output)
+    check_output(output, [path])
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress(f"selecting features ({method.value})", None) as update:
         result = run(path, output, method=method.value, top=top, group_channels=group_channels,

@@ -23,7 +23,7 @@ def train(
     """Train each behaviour's predictor of its labels (effect categories or given results), probabilities calibrated."""
     from afford.api import train as run
 
-    check_output(output)
+    check_output(output, [path])
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress("training predictors", None) as update:
         result = run(path, output, kernel=kernel.value if kernel is not None else None, folds=folds, seed=seed,
