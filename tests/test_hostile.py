@@ -458,3 +458,86 @@ def test_a_forged_learning_file_is_refused_when_read(pipeline, tmp_path, case, s
     errors = [line for line in result.output.splitlines() if line.startswith("error:")]
     assert len(errors) == 1 and str(path) in errors[0] and message in errors[0], (case, result.output)
     assert path.read_bytes() == before and not (tmp_path / "o.afford").exists()
+
+
+# -- pddl's output directory -----------------------------------------------------------------
+
+@pytest.mark.parametrize("where, message", [
+    ("-", "pddl writes four files, not one stream; give a directory"),
+    ("", "give a directory for the PDDL files"),
+])
+def test_pddl_refuses_a_stream_or_no_directory(pipeline, tmp_path, monkeypatch, where, message):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    monkeypatch.chdir(tmp_path)
+    result = CliRunner().invoke(app, ["pddl", str(pipeline / "model.afford"), "--goal", "*:visibility=0",
+                                      "--seed", "1", "-o", where])
+    assert result.exit_code == 1, result.output
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and message in errors[0], result.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_pddl_says_it_cannot_write_a_directory_it_may_not_make(pipeline, tmp_path, monkeypatch):
+    """As root nothing is denied, so the operating system's refusal is simulated."""
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    def denied(self, *a, **kw):
+        raise PermissionError(13, "Permission denied", str(self))
+
+    monkeypatch.setattr(Path, "mkdir", denied)
+    out = tmp_path / "pddl"
+    result = CliRunner().invoke(app, ["pddl", str(pipeline / "model.afford"), "--goal", "*:visibility=0",
+                                      "--seed", "1", "-o", str(out)])
+    assert result.exit_code == 1, result.output
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert errors == [f"error: cannot write {out}: permission denied"], result.output
+
+
+# -- reports and wording ---------------------------------------------------------------------
+
+def test_cluster_reports_the_interactions_it_dropped(pipeline, tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    runner = CliRunner()
+    args = ["cluster", str(pipeline / "test.afford"), "-o", str(tmp_path / "e.afford"), "--seed", "1"]
+    data = json.loads(runner.invoke(app, [*args, "--json"]).stdout)
+    human = runner.invoke(app, args)
+    assert human.exit_code == 0, human.output
+    for name, b in data["behaviors"].items():
+        total = b["pruned_rows"] + sum(c["count"] for c in b["categories"])
+        assert f"{name}: {b['pruned_rows']} of {total} interactions dropped (rare kinds)" in human.output
+
+
+def test_cluster_advice_names_the_command_line_options(pipeline, tmp_path):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    result = CliRunner().invoke(app, ["cluster", str(pipeline / "test.afford"), "-o", str(tmp_path / "e.afford"),
+                                      "--min-fraction", "0.5"])
+    assert result.exit_code == 1, result.output
+    assert "lower --min-fraction" in result.output
+    assert "min_fraction" not in result.output and "predictability_threshold" not in result.output
+
+
+def test_merging_one_shard_says_one_shard(pipeline, tmp_path):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+    from afford.artifacts import read_artifact
+
+    episodes = read_artifact(str(pipeline / "train.afford")).arrays["episode"]
+    shard = forge(pipeline / "train.afford", tmp_path / "shard.afford",
+                  manifest=lambda m: m.update(episodes={"start": 0, "stop": int(episodes.max()) + 1}))
+    result = CliRunner().invoke(app, ["merge", str(shard), "-o", str(tmp_path / "m.afford")])
+    assert result.exit_code == 0, result.output
+    assert "merged 1 shard:" in result.output
