@@ -115,7 +115,7 @@ def cluster(path: str, output: str, *, method: str | None = None, k_max: int | N
     from afford.learn.affordances import discover_effects
     from afford.learning import clustering_settings, effects_members
 
-    check_output(output)
+    check_output(output, [path])
     art, data = read_rows(path)
     if not data.has_after:
         raise AffordError(f"{art.source} records nothing after its behaviours, so it has no effects to cluster; "
@@ -154,7 +154,7 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
     from afford.learn.affordances import rank_features
     from afford.learning import features_members, learner_settings, selection_score
 
-    check_output(output)
+    check_output(output, [path])
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
     kernel_name, _ = learner_settings(art, data, kernel)
@@ -182,7 +182,7 @@ def train(path: str, output: str, *, kernel: str | None = None, folds: int | Non
     from afford.learn.affordances import train_known, train_members, train_predictors
     from afford.learning import learner_settings, model_members, read_selection
 
-    check_output(output)
+    check_output(output, [path])
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, effects = read_effects(art, data)
     selected = read_selection(art, data)
@@ -282,7 +282,7 @@ def merge(paths: Sequence[str], output: str) -> dict:
     from afford.datasets import check_shards, interactions_members
     from afford.features import Interactions
 
-    check_output(output)
+    check_output(output, list(paths))
     if len(paths) < 1:
         raise AffordError("give the shards to merge")
     shards = [read_rows(p, ("interactions",)) for p in paths]

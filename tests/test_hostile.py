@@ -541,3 +541,17 @@ def test_merging_one_shard_says_one_shard(pipeline, tmp_path):
     result = CliRunner().invoke(app, ["merge", str(shard), "-o", str(tmp_path / "m.afford")])
     assert result.exit_code == 0, result.output
     assert "merged 1 shard:" in result.output
+
+
+def test_the_python_api_refuses_an_output_that_is_an_input_too(pipeline, tmp_path):
+    from afford import api
+    from afford.errors import AffordError
+
+    for call, src in ((lambda p: api.train(p, p), "features.afford"), (lambda p: api.cluster(p, p), "train.afford"),
+                      (lambda p: api.select_features(p, p), "effects.afford"), (lambda p: api.merge([p], p), "train.afford")):
+        x = tmp_path / src
+        shutil.copy(pipeline / src, x)
+        before = x.read_bytes()
+        with pytest.raises(AffordError, match="is an input of this command"):
+            call(str(x))
+        assert x.read_bytes() == before
