@@ -555,3 +555,17 @@ def test_the_python_api_refuses_an_output_that_is_an_input_too(pipeline, tmp_pat
         with pytest.raises(AffordError, match="is an input of this command"):
             call(str(x))
         assert x.read_bytes() == before
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--method", "kmeans", "--kmax", "3"], "--kmax bounds X-means"),
+    (["--prune", "predictability", "--min-fraction", "0.2"], "--min-fraction goes with --prune frequency"),
+    (["--method", "kmeans", "--k", "3", "--k", "4"], "--k is given twice for every behaviour"),
+    (["--method", "kmeans", "--k", "lift=3", "--k", "lift=2"], "--k is given twice for lift"),
+])
+def test_cluster_refuses_an_option_it_would_ignore(pipeline, tmp_path, extra, words):
+    from tests.clitools import fails
+
+    out = tmp_path / "e.afford"
+    assert words in fails(["cluster", str(pipeline / "train.afford"), "-o", str(out), *extra], code=2)
+    assert not out.exists()

@@ -38,7 +38,10 @@ def parse_k(values: list[str] | None) -> dict[str, int] | None:
             raise typer.BadParameter(f"--k takes K or BEHAVIOUR=K with K a whole number, got {v!r}") from None
         if not 2 <= n <= 50:
             raise typer.BadParameter(f"--k must be 2-50 clusters, got {n}")
-        out[name.strip() or "*"] = n
+        key = name.strip() or "*"
+        if key in out:
+            raise typer.BadParameter(f"--k is given twice for {'every behaviour' if key == '*' else key}; give it once")
+        out[key] = n
     return out
 
 
@@ -62,7 +65,7 @@ def cluster(
     kmax: Annotated[Optional[int], typer.Option("--kmax", min=1, max=20, help="Most categories X-means may find in one channel. Default: the scene's own (grasp: 4), else 5.")] = None,
     k: Annotated[Optional[list[str]], typer.Option("--k", help="Clusters of k-means: K for every behaviour, or BEHAVIOUR=K for one (repeat the option).")] = None,
     prune: Annotated[Prune, typer.Option(help="Drop rare categories (chapter 8) or unpredictable ones (Algorithm 7).")] = Prune.frequency,
-    min_fraction: Annotated[float, typer.Option("--min-fraction", min=0.0, max=0.5, help="Frequency pruning: smallest share a category must hold.")] = 0.03,
+    min_fraction: Annotated[Optional[float], typer.Option("--min-fraction", min=0.0, max=0.5, help="Frequency pruning: smallest share a category must hold.  [default: 0.03]")] = None,
     channels: Annotated[Optional[str], typer.Option("--channels", help="Comma-separated effect channels that form categories (hierarchical); the others still shape the prototypes. Default: the scene's own (grasp: visibility,cp,touch, as tables 9.1-9.2), else all.")] = None,
     seed: Seed = 0,
     json: Json = False,
@@ -73,11 +76,16 @@ def cluster(
     ks = parse_k(k)
     if ks is not None and method is Method.hierarchical:
         raise typer.BadParameter("--k goes with --method kmeans")
+    if kmax is not None and method is Method.kmeans:
+        raise typer.BadParameter("--kmax bounds X-means (--method hierarchical); k-means takes --k")
+    if min_fraction is not None and prune is Prune.predictability:
+        raise typer.BadParameter("--min-fraction goes with --prune frequency; predictability pruning drops "
+                                 "the categories the features cannot tell apart, whatever their share")
     check_output(output, [path])
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress("clustering effects (behaviours)", None, lazy=True) as update, _cli_wording(prune):
         result = run(path, output, method=None if method is None else method.value, k_max=kmax, k=ks, prune=prune.value,
-                     min_fraction=min_fraction, seed=seed, progress=update,
+                     min_fraction=0.03 if min_fraction is None else min_fraction, seed=seed, progress=update,
                      channels=None if channels is None else [c.strip() for c in channels.split(",") if c.strip()])
 
     def render(console):
