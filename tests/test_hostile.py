@@ -460,6 +460,22 @@ def test_a_forged_learning_file_is_refused_when_read(pipeline, tmp_path, case, s
     assert path.read_bytes() == before and not (tmp_path / "o.afford").exists()
 
 
+
+@pytest.mark.parametrize("case", [
+    "selected-out-of-range", "model-selected-out-of-range", "effects-in-predictor-slot", "logistic-in-predictor-slot",
+    "nested-swap", "train-x-shape", "predictor-swapped-between-behaviours", "categories-count", "prototypes-strings",
+    "missing-member", "member-effects-short", "member-effects-category", "member-effects-meta"])
+def test_inspect_verifies_only_what_the_consuming_commands_would_open(forged, case):
+    from typer.testing import CliRunner
+
+    from afford.app import app
+
+    path, _ = forged[case]
+    result = CliRunner().invoke(app, ["inspect", str(path)])
+    assert result.exit_code == 1 and "verified" not in result.output, (case, result.output)
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and str(path) in errors[0], (case, result.output)
+
 # -- pddl's output directory -----------------------------------------------------------------
 
 @pytest.mark.parametrize("where, message", [

@@ -199,12 +199,29 @@ def _start_images(art: Artifact, info: dict, plot_dir) -> list[str]:
     return [range_images_figure(plot_dir / "range-images.png", starts)] if starts else []
 
 
+def check_as_used(art: Artifact) -> None:
+    """Make the checks the commands that consume ``art`` make (a model's estimators of their
+    trusted parts, labels within their categories, a selection within the schema), so that
+    ``inspect`` calls verified only what they would open."""
+    from afford.learning import LoadedModel, read_effects, read_selection
+
+    if art.kind == "model":
+        LoadedModel(art)
+        return
+    data = interactions_from_artifact(art)
+    if art.kind in ("effects", "features"):
+        read_effects(art, data)
+    if art.kind == "features":
+        read_selection(art, data)
+
+
 def inspect(path: InputPath, json: Json = False, plots: PlotDir = None) -> None:
     """Report any afford artefact (kind, lineage, features, categories, outcomes) and verify its checksums."""
     out = Output(json)
     plot_dir = plot_directory(plots) if plots is not None else None
     art = read_artifact(path)
     with reading(art):  # a forged manifest (checksums recomputed) is one sentence, not a traceback
+        check_as_used(art)
         info = describe(art)
         if plot_dir is not None:
             info["plots"] = artefact_plots(info, plot_dir)
