@@ -146,6 +146,10 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
         fr = FeatureRelevance(method=method, top=top, feature_groups=g, random_state=behaviour_seed(seed, b),
                               estimator=prefix_estimator(kernel) if method == "relieff" else None, scoring=score)
         out[name] = _split_parameters(fr.fit(X, y), d, params)
+        if out[name].selected_.size == 0 and not params:
+            # One effect only (nothing to tell apart): the predictor will be certain of it
+            # whatever it reads, but it must read something; the first feature serves.
+            out[name].selected_ = np.asarray(out[name].ranking_[:1], dtype=int)
         if progress is not None:
             progress(b + 1)
     return out

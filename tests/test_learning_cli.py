@@ -304,3 +304,20 @@ def test_predict_on_a_grasp_model_runs_each_behaviour_with_the_alpha_it_chose_in
     msg = fails(["predict", model, "--scene", "traverse", "--seed", "1"])
     assert msg.strip().splitlines() == ["error: scene 'traverse' perceives 3900 features, the model reads 25 "
                                         "(it was learned in scene 'grasp'); leave out --scene to act in the model's own scene"]
+
+
+def test_a_behaviour_that_never_changed_anything_trains_as_certain_beside_the_others(pipeline, tmp_path):
+    """push-forward's effects erased: select-features keeps it one feature, train makes it certain."""
+    def still(d):
+        pf = d.behavior == d.behavior_names.index("push-forward")
+        d.after_index[pf] = d.before_index[pf]
+        return d
+    path = _variant(pipeline, tmp_path, "still", still)
+    e, f, m = (str(tmp_path / n) for n in ("e.afford", "f.afford", "m.afford"))
+    ok(["cluster", str(path), "-o", e])
+    ok(["select-features", e, "-o", f])
+    out = json.loads(ok(["train", f, "-o", m, "--json"]).stdout)
+    assert out["behaviors"]["push-forward"]["n_categories"] == 1
+    assert out["behaviors"]["lift"]["n_categories"] > 1
+    pred = json.loads(ok(["predict", m, "--seed", "3", "--json"]).stdout)
+    assert all(o["behaviors"]["push-forward"]["probability"] == 1.0 for o in pred["objects"] if o["visible"])
