@@ -96,8 +96,9 @@ def interactions_from_artifact(art: Artifact) -> Interactions:
         else:  # written before entities were stored once: a before and an after per row
             data = Interactions.from_rows(schema, list(m["behaviors"]), a["before"], a["after"], **rows, **rest)
     except (KeyError, TypeError, ValueError, AttributeError, IndexError) as exc:
-        raise AffordError(f"{art.source} does not hold interaction rows that fit together ({type(exc).__name__}: "
-                          f"{exc}); it is corrupt or was edited") from None
+        why = f"it lacks {exc.args[0]!r}" if isinstance(exc, KeyError) and exc.args else str(exc)
+        raise AffordError(f"{art.source} does not hold interaction rows that fit together ({why}); "
+                          "it is corrupt or was edited") from None
     try:
         data.validate()
     except ValueError as exc:

@@ -585,3 +585,11 @@ def test_cluster_refuses_an_option_it_would_ignore(pipeline, tmp_path, extra, wo
     out = tmp_path / "e.afford"
     assert words in fails(["cluster", str(pipeline / "train.afford"), "-o", str(out), *extra], code=2)
     assert not out.exists()
+
+
+def test_a_manifest_without_its_schema_is_named_without_python_words(pipeline, tmp_path):
+    from tests.clitools import fails
+
+    path = forge(pipeline / "train.afford", tmp_path / "noschema.afford", manifest=lambda m: m.pop("schema"))
+    msg = fails(["cluster", str(path), "-o", str(tmp_path / "e.afford")])
+    assert "lacks 'schema'" in msg and "KeyError" not in msg, msg
