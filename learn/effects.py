@@ -46,7 +46,12 @@ from afford.features.schema import FeatureSchema
 from afford.learn.validation import check_finite
 from afford.learn.xmeans import XMeans
 
-__all__ = ["EffectCategories"]
+__all__ = ["EffectCategories", "NoCategoryLeft"]
+
+
+class NoCategoryLeft(DataError):
+    """Pruning left no effect category (the command line words its advice in its options)."""
+
 
 # Predictability checks train one classifier per candidate category; above this many rows
 # they run on a random subsample of this size (stratification is kept by the CV splitter).
@@ -347,7 +352,7 @@ class EffectCategories(BaseEstimator):
                 keep[:] = True
         kept = np.flatnonzero(keep)
         if kept.size == 0:
-            raise DataError(
+            raise NoCategoryLeft(
                 "no effect category survived pruning; lower min_fraction or "
                 "predictability_threshold, or collect more interactions."
             )

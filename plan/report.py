@@ -16,7 +16,7 @@ def summarise(entries: list[dict], executed: bool) -> dict:
         if not p["found"]:
             continue
         key = str(p["length"])
-        slot = by_length.setdefault(key, {"found": 0, "reached": 0})
+        slot = by_length.setdefault(key, {"found": 0, "reached": 0 if executed else None})  # null: nothing ran
         slot["found"] += 1
         probs.append(p["success_probability"])
         blind.append(p["open_loop_probability"])
@@ -29,7 +29,10 @@ def summarise(entries: list[dict], executed: bool) -> dict:
            "mean_success_probability": round(float(np.mean(probs)), 4) if probs else None,
            "mean_open_loop_probability": round(float(np.mean(blind)), 4) if blind else None,
            "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in planned] or [0.0])), 4),
-           "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in planned] or [0.0])), 1)}
+           "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in planned] or [0.0])), 1),
+           # the search and the candidates' assessment (a caller that times the search alone: its time)
+           "mean_planning_seconds": round(sum(e.get("planning_seconds", e["plan"]["seconds"]) for e in planned)
+                                          / max(1, len(planned)), 4)}
     if executed:
         out["reached"] = sum(int(e.get("reached", False)) for e in entries)
         out["first_plan_worked"] = int(sum(first_ok))

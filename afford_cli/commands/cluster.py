@@ -10,7 +10,6 @@ import typer
 
 from afford.artifacts import check_output, writes_stdout
 from afford.errors import AffordError
-from afford.features.errors import DataError
 from afford.options import InputPath, Json, OutputPath, Seed
 from afford.output import Output
 
@@ -48,11 +47,11 @@ def parse_k(values: list[str] | None) -> dict[str, int] | None:
 @contextmanager
 def _cli_wording(prune: "Prune"):
     """The learner's advice in the command line's words (its options, not Python names)."""
+    from afford.learn.effects import NoCategoryLeft  # the learner loads with the command, not at start-up
+
     try:
         yield
-    except DataError as exc:
-        if "survived pruning" not in str(exc):
-            raise
+    except NoCategoryLeft:
         advice = ("lower --min-fraction" if prune is Prune.frequency else
                   "cluster with --prune frequency (the features told no category apart well enough)")
         raise AffordError(f"no effect category survived pruning; {advice}, or collect more interactions") from None

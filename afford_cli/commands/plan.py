@@ -132,11 +132,6 @@ def plan(
                                     "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})
                 update(e + 1)
     result = summarise(entries, execute)
-    if not execute:  # nothing ran: nothing was reached, nor missed
-        for v in result["by_length"].values():
-            v["reached"] = None
-    planned = [e for e in entries if "skipped" not in e]
-    result["mean_planning_seconds"] = round(sum(e["planning_seconds"] for e in planned) / max(1, len(planned)), 4)
     result["goal"] = g.to_json()
     if episodes == 1:
         result.update(single_plan(entries[0], execute))
