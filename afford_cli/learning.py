@@ -352,6 +352,9 @@ class LoadedModel:
         try:
             if any(a is None for a in parts.values()) or not isinstance(meta[name], dict):
                 raise ValueError("parts are missing")
+            for part in ("Zu", "Eu"):  # the pool of discarded members: models from before it have none
+                if f"members_{part}.{name}" in art.arrays:
+                    parts[part] = art.arrays[f"members_{part}.{name}"]
             members = MemberEffects.from_arrays(parts, meta[name])
         except ValueError:
             raise AffordError(f"{art.source}: the member effects of {name} do not fit together; "

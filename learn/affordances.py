@@ -250,17 +250,19 @@ def train_members(data: Interactions, labels: np.ndarray, *, seed: int = 0) -> d
 
     It reads every entity feature (:func:`known_columns`) and the behaviour's parameters:
     how far a push moves an object depends on its width, which the features chosen to tell
-    the categories apart need not include. Behaviours without kept rows get none (``None``).
+    the categories apart need not include. The behaviour's rows of a discarded kind (label
+    below 0) go along as the pool an unknown outcome is drawn from. Behaviours without kept
+    rows get none (``None``).
     """
     from afford.learn.members import MemberEffects
 
     out: dict = {}
     cols = known_columns(data.schema)
     for b, name in enumerate(data.behavior_names):
-        rows = behaviour_rows(data, b, labels)
-        if rows.size == 0:
+        if behaviour_rows(data, b, labels).size == 0:
             out[name] = None
             continue
+        rows = behaviour_rows(data, b)
         params = parameters_of(data, b)
         X = predictor_inputs(data.before_rows(rows), data.params[rows], cols, params)
         groups = [data.schema.channels[i] for i in cols] + ["parameters"] * (X.shape[1] - cols.size)

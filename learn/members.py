@@ -17,6 +17,13 @@ its six position features. Measured on 5000 table interactions (held out: 1000 o
 seed, categories given), five neighbours cut the 90th percentile of the position error from
 11-13 cm to 4-6 cm on the pushes, and the median from about 3 cm to 1-1.5 cm.
 
+Members of a kind the categories discarded (a rare effect, pruned: label below 0) are kept
+apart, as a pool: they teach no category, yet they are what the robot saw happen. When the
+model gives an object a chance of an unknown outcome (P(known) < 1), an imagined world asks
+:meth:`MemberEffects.unknown_effects` what the most similar of them did, rather than assuming
+that nothing happens: on 5000 table interactions many pushes whose effect fell outside the
+kept kinds (the shape bins set them apart) still moved the object much as the kept ones did.
+
 Everything fitted is plain arrays (:meth:`to_arrays` / :meth:`from_arrays`), so a model
 file holds it without any code.
 """
@@ -25,10 +32,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["MemberEffects", "JointMembers", "K_GRID"]
+__all__ = ["MemberEffects", "JointMembers", "K_GRID", "UNKNOWN_K"]
 
 #: Neighbour counts tried; 0 means every member of the category (the thesis's prototype).
 K_GRID = (3, 5, 10, 20, 0)
+
+#: Discarded members an unknown outcome is drawn from: the most similar this many.
+UNKNOWN_K = 5
 
 #: Members per category the leave-one-out choice of k looks at, at most (a random sample).
 LOO_ROWS = 1500
@@ -59,6 +69,9 @@ class MemberEffects:
         jitter does not, so each channel takes the count that predicts it best.
     loo_error_ : dict of str to dict of int to float
         Per channel, the mean leave-one-out error of each k tried (tolerance units).
+    Zu_, Eu_ : arrays
+        The discarded members (label below 0): their scaled inputs and their effects, the
+        pool :meth:`unknown_effects` draws from (empty where none were given).
     """
 
     def __init__(self, groups, effect_groups, tolerances, k_grid: tuple[int, ...] = K_GRID, random_state: int = 0):
@@ -71,13 +84,16 @@ class MemberEffects:
     # -- fitting ---------------------------------------------------------------------------
     def fit(self, X: np.ndarray, E: np.ndarray, labels: np.ndarray) -> "MemberEffects":
         """``X``: the inputs (entity features, then encoded parameters), ``E``: the effects,
-        ``labels``: each row's category (rows below 0, pruned, are left out)."""
+        ``labels``: each row's category (rows below 0, pruned, teach no category: they form
+        the pool of discarded members, scaled as the kept ones are)."""
         X, E, labels = np.asarray(X, dtype=float), np.asarray(E, dtype=float), np.asarray(labels, dtype=int)
-        keep = labels >= 0
-        X, E, labels = X[keep], E[keep], labels[keep]
         if X.shape[1] != len(self.groups) or E.shape[1] != len(self.effect_groups):
             raise ValueError(f"MemberEffects was given {X.shape[1]} inputs and {E.shape[1]} effect columns for "
                              f"{len(self.groups)} groups and {len(self.effect_groups)} effect channels")
+        keep = labels >= 0
+        pool = ~keep & np.isfinite(X).all(axis=1) & np.isfinite(E).all(axis=1)
+        Xu, Eu = X[pool], E[pool]
+        X, E, labels = X[keep], E[keep], labels[keep]
         self.shift_ = X.mean(axis=0) if len(X) else np.zeros(X.shape[1])
         sd = X.std(axis=0) if len(X) else np.ones(X.shape[1])
         g = np.asarray(self.groups)
@@ -88,6 +104,8 @@ class MemberEffects:
         self.Z_ = ((X - self.shift_) * self.weight_).astype(np.float32)
         self.E_ = E.astype(np.float32)
         self.labels_ = labels.astype(np.int16)
+        self.Zu_ = ((Xu - self.shift_) * self.weight_).astype(np.float32)
+        self.Eu_ = Eu.astype(np.float32)
         self.loo_error_ = self._leave_one_out()
         self.k_ = {ch: (min(errors, key=lambda k: (errors[k], k != 0, k)) if errors else 0)
                    for ch, errors in self.loo_error_.items()}
@@ -313,6 +331,16 @@ class MemberEffects:
         uses: the distribution a rollout draws that channel from."""
         return self._E[self.neighbours(x, category, channel)]
 
+    def unknown_effects(self, x: np.ndarray, k: int = UNKNOWN_K) -> np.ndarray:
+        """The effects the ``k`` discarded members nearest to input ``x`` had, nearest first
+        (ties: the lower row); shape ``(≤ k, n_features)``, empty where the pool is."""
+        if self.Eu_.shape[0] == 0:
+            return self.Eu_.astype(float)
+        z = (np.asarray(x, dtype=float) - self.shift_) * self.weight_
+        Zu = self.Zu_.astype(float)
+        d = ((Zu - z) ** 2).sum(axis=1)
+        return self.Eu_[np.argsort(d, kind="stable")[:k]].astype(float)
+
     def predict(self, x: np.ndarray, category: int) -> tuple[np.ndarray, np.ndarray]:
         """(mean effect, its spread: per channel the standard deviation of the effects of the
         members that channel's mean rests on)."""
@@ -329,7 +357,7 @@ class MemberEffects:
     # -- storing ---------------------------------------------------------------------------
     def to_arrays(self) -> tuple[dict[str, np.ndarray], dict]:
         """Plain arrays and a JSON-able description, all a model file needs to hold."""
-        arrays = {"Z": self.Z_, "E": self.E_, "labels": self.labels_,
+        arrays = {"Z": self.Z_, "E": self.E_, "labels": self.labels_, "Zu": self.Zu_, "Eu": self.Eu_,
                   "shift": self.shift_.astype(np.float64), "weight": self.weight_.astype(np.float64)}
         meta = {"k": {ch: int(k) for ch, k in self.k_.items()}, "groups": list(self.groups),
                 "effect_groups": list(self.effect_groups), "tolerances": [float(t) for t in self.tolerances],
@@ -339,7 +367,9 @@ class MemberEffects:
 
     @classmethod
     def from_arrays(cls, arrays: dict[str, np.ndarray], meta: dict) -> "MemberEffects":
-        """The fitted model back from :meth:`to_arrays`; ``ValueError`` when the parts do not fit together."""
+        """The fitted model back from :meth:`to_arrays`; ``ValueError`` when the parts do not fit
+        together. The pool of discarded members (``Zu``, ``Eu``) is optional: models from
+        before it existed have none."""
         try:
             self = cls(meta["groups"], meta["effect_groups"], meta["tolerances"])
             self.k_ = {str(ch): int(k) for ch, k in dict(meta["k"]).items()}
@@ -347,6 +377,8 @@ class MemberEffects:
                                for ch, errors in dict(meta.get("loo_error", {})).items()}
             Z, E, labels = arrays["Z"], arrays["E"], arrays["labels"]
             shift, weight = arrays["shift"], arrays["weight"]
+            Zu = arrays.get("Zu")
+            Eu = arrays.get("Eu")
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"the member effects are incomplete ({exc})") from None
         n, d = Z.shape if Z.ndim == 2 else (-1, -1)
@@ -355,6 +387,15 @@ class MemberEffects:
                 or set(self.k_) != set(self.channels) or min(self.k_.values(), default=0) < 0 or labels.dtype.kind not in "iu" or (labels.size and labels.min() < 0) or Z.dtype.kind != "f" or E.dtype.kind != "f"
                 or not (np.all(np.isfinite(Z)) and np.all(np.isfinite(E)))):
             raise ValueError("the member effects' arrays do not fit together")
+        if (Zu is None) != (Eu is None):
+            raise ValueError("the discarded members lack their inputs or their effects")
+        if Zu is None:
+            Zu, Eu = np.zeros((0, d), dtype=np.float32), np.zeros((0, E.shape[1]), dtype=np.float32)
+        if (Zu.ndim != 2 or Eu.ndim != 2 or Zu.shape[0] != Eu.shape[0] or Zu.shape[1] != d
+                or Eu.shape[1] != E.shape[1] or Zu.dtype.kind != "f" or Eu.dtype.kind != "f"
+                or not (np.all(np.isfinite(Zu)) and np.all(np.isfinite(Eu)))):
+            raise ValueError("the discarded members' arrays do not fit together")
+        self.Zu_, self.Eu_ = Zu.astype(np.float32), Eu.astype(np.float32)
         self.Z_, self.E_, self.labels_ = Z.astype(np.float32), E.astype(np.float32), labels.astype(np.int16)
         self.shift_, self.weight_ = shift.astype(float), weight.astype(float)
         self._index()

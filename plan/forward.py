@@ -8,7 +8,9 @@ the mean effect of the members of E whose entities looked most like f
 members' effects; ``effects="prototype"`` gives the thesis's model, f + prototype(E), for
 every member alike (models trained before member effects existed have only that). Where the model also learned P(known | f, b, alpha),
 the chance that the effect is of a kind its categories kept at all, the category
-probabilities are multiplied by it: the rest is an unknown outcome, which no plan counts on. An object that the prototype makes vanish keeps its
+probabilities are multiplied by it: the rest is an unknown outcome, which no plan counts on
+(an imagined world, :func:`afford.plan.monitor.reach_probability`, draws it from what the
+discarded members most like f did: :meth:`ForwardModel.draw_unknown`). An object that the prototype makes vanish keeps its
 last seen position and shape with visibility 0, as perception does.
 
 Predictions depend only on the object's own features, so they are cached by the object's
@@ -528,9 +530,30 @@ class ForwardModel:
             effects = members.effects(x, category, channel)
             mine = cols[channels[cols] == channel]
             out[mine] = effects[r % len(effects)][mine]
+        return self._snap(f, out)
+
+    def _snap(self, f: np.ndarray, effect: np.ndarray) -> np.ndarray:
+        """``effect`` with its geometry snapped so that ``f`` lands on the lattice of a
+        quarter of each feature's goal tolerance (see :meth:`draw_effect`)."""
+        out = effect.copy()
+        cols = self.schema.geometry
         step = self.schema.tolerances[cols] / 4.0
         out[cols] = np.round((f[cols] + out[cols]) / step) * step - f[cols]
         return out
+
+    def draw_unknown(self, f: np.ndarray, b: int, alpha: tuple, rng: np.random.Generator) -> np.ndarray | None:
+        """One effect of a kind the categories discarded, as a world might give it: the whole
+        effect one of the discarded members most like ``f`` had (snapped as
+        :meth:`draw_effect` snaps). None where there is nothing to draw from: the prototype
+        model, or a model without discarded members (an unknown outcome is then taken to
+        leave the object as it was)."""
+        members = self.behaviors[b].members
+        if self.effects != "members" or members is None:
+            return None
+        pool = members.unknown_effects(self._member_input(self.behaviors[b], f, alpha))
+        if pool.shape[0] == 0:
+            return None
+        return self._snap(f, pool[int(rng.integers(1 << 30)) % pool.shape[0]])
 
     def _moved(self, before: np.ndarray, b: int, category: int, alpha: tuple = (),
                effect: np.ndarray | None = None) -> np.ndarray:

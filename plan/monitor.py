@@ -186,7 +186,10 @@ class _Imagined:
     object vector gives the same outcome again (the world is not a die: a push that left an
     object where it was will leave it there again), so a rollout is one world the model
     thinks possible. An outcome of a kind the model does not know (the probability it gives
-    to none of its categories) leaves the object as it was.
+    to none of its categories) does what one of the discarded members most like the object
+    did (:meth:`ForwardModel.draw_unknown`), or, where the model kept none, leaves the object
+    as it was. Assuming "unknown: nothing happens" made plans look worse than they were:
+    at the table many pushes of a discarded kind moved their objects as the kept kinds do.
     """
 
     def __init__(self, model: ForwardModel, state: np.ndarray, rng: np.random.Generator):
@@ -197,9 +200,11 @@ class _Imagined:
         return self.state.copy()
 
     def _fate(self, f: np.ndarray, b: int, alpha: tuple):
-        """(category, effect) this world holds for behaviour ``b`` on entity ``f`` (None: an
-        unknown kind): the category drawn from the model's distribution, the effect from
-        those the category's members most like ``f`` had (:meth:`ForwardModel.draw_effect`)."""
+        """(category, effect) this world holds for behaviour ``b`` on entity ``f``: the
+        category drawn from the model's distribution, the effect from those the category's
+        members most like ``f`` had (:meth:`ForwardModel.draw_effect`). An unknown kind is
+        category -1 with an effect a discarded member had (:meth:`ForwardModel.draw_unknown`),
+        or None (nothing happens) where there is none to draw."""
         key = (f.tobytes(), b, alpha)
         if key not in self.fate:
             classes, proba = self.model.distribution(f, b, alpha)
@@ -209,7 +214,8 @@ class _Imagined:
                 c = int(classes[min(np.searchsorted(edges, r, side="right"), len(classes) - 1)])
                 self.fate[key] = (c, self.model.draw_effect(f, b, c, alpha, self.rng))
             else:
-                self.fate[key] = None
+                effect = self.model.draw_unknown(f, b, alpha, self.rng)
+                self.fate[key] = None if effect is None else (-1, effect)
         return self.fate[key]
 
     def act(self, behavior: str, target: int, alpha: np.ndarray | None = None) -> np.ndarray:

@@ -106,6 +106,23 @@ def test_member_effects_round_trip_through_plain_arrays_and_refuse_parts_that_do
         MemberEffects.from_arrays(arrays, {**meta, "k": "many"})
     with pytest.raises(ValueError):
         MemberEffects.from_arrays(arrays, {**meta, "k": {"position": 5}})  # a channel without its count
+    # the pool of discarded members (label -1) travels with the rest and is checked the same way
+    discarded = labels.copy()
+    discarded[:40] = -1
+    arrays, meta = _members(X, E, discarded).to_arrays()
+    assert arrays["Zu"].shape == (40, 2) and arrays["Eu"].shape == (40, 2)
+    assert np.array_equal(MemberEffects.from_arrays(arrays, meta).unknown_effects(x), _members(X, E, discarded).unknown_effects(x))
+    bad = arrays["Eu"].copy()
+    bad[3, 0] = np.nan
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays({**arrays, "Eu": bad}, meta)
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays({**arrays, "Eu": arrays["Eu"][:7]}, meta)
+    with pytest.raises(ValueError):
+        MemberEffects.from_arrays({k: a for k, a in arrays.items() if k != "Zu"}, meta)
+    # a model from before the pool existed loads with an empty one
+    old = MemberEffects.from_arrays({k: a for k, a in arrays.items() if k not in ("Zu", "Eu")}, meta)
+    assert old.unknown_effects(x).shape == (0, 2)
 
 
 class _Const:
@@ -149,6 +166,56 @@ def test_the_planner_moves_each_object_by_its_own_effect_and_rollouts_draw_from_
     assert tight_plan.found
     p = reach_probability(fm, wide, tight, tight_plan, max_replans=0, rollouts=200, seed=0)
     assert 0.05 < p < 0.85
+
+
+class _Unsure:
+    """P(known) of one half for every object."""
+
+    classes_ = np.array([0, 1])
+
+    def predict_proba(self, X):
+        return np.tile([0.5, 0.5], (len(X), 1))
+
+
+class _Sure:
+    """A predictor certain of category 0."""
+
+    classes_ = np.array([0, 1])
+
+    def predict_proba(self, X):
+        return np.tile([1.0, 0.0], (len(X), 1))
+
+
+def test_an_unknown_kind_does_what_the_most_similar_discarded_members_did():
+    """Half the pushes are of a kind the categories discarded, yet those pushes moved their
+    objects as the kept ones did (their colour bins changed, say): imagined worlds that draw
+    an unknown outcome from the discarded members expect the goal to be reached; without the
+    pool an unknown outcome leaves the object put, and half the worlds miss it."""
+    rng = np.random.default_rng(8)
+    X, E, labels = _planted(800, rng)
+    labels[:] = 0
+    labels[rng.random(800) < 0.5] = -1
+    E[labels == -1, 1] = 0.5  # a change the kept kind never shows, beside the same push
+    E[:, 0] = X[:, 0] / 2 + rng.normal(0, 0.005, 800)
+    schema = FeatureSchema(("x", "colour"), ("position", "colour"))
+    wide = np.array([[0.38, 0.5]])
+
+    def chance(m: MemberEffects) -> float:
+        b = BehaviorModel("push", _Sure(), np.array([0, 1]), np.array([[E[labels == 0, 0].mean(), 0.0]]),
+                          members=m, known=_Unsure())
+        fm = ForwardModel([b], schema, effects="members")
+        aim = fm.apply(wide, 0, 0, 0)[0, 0]
+        goal = parse_goal([f"0:x={aim:.4f}~0.03"], schema)
+        plan = best_first(fm, wide, goal, max_depth=1)
+        assert plan.found and plan.success_probability == pytest.approx(0.5, abs=0.01)
+        return reach_probability(fm, wide, goal, plan, max_replans=0, rollouts=300, seed=0)
+
+    with_pool = _members(X, E, labels)
+    assert with_pool.Eu_.shape[0] == (labels == -1).sum()
+    arrays, meta = with_pool.to_arrays()
+    without = MemberEffects.from_arrays({k: a for k, a in arrays.items() if k not in ("Zu", "Eu")}, meta)
+    assert chance(with_pool) > 0.95
+    assert 0.35 < chance(without) < 0.65
 
 
 def _reference_means(m: MemberEffects, x: np.ndarray) -> np.ndarray:
