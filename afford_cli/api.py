@@ -142,12 +142,14 @@ def _per_behaviour(progress, data):
 
 def select_features(path: str, output: str, *, method: str = "relieff", top: int | None = None,
                     group_channels: bool = False, kernel: str | None = None, score: str | None = None,
-                    seed: int = 0, progress: Callable[[int, int], None] | None = None) -> dict:
+                    seed: int = 0, progress: Callable[[int, int], None] | None = None,
+                    warn: Callable[[str], None] | None = None) -> dict:
     """Rank the features by relevance to each behaviour's labels (ReliefF, Algorithm 3, or a
     wrapper) and keep the best: reads effects or interactions with given results, writes
     ``features``; returns the summary ``afford select-features --json`` prints. ``score``
     (``"accuracy"`` or ``"log_loss"``: what ReliefF's ranking cut scores) and ``kernel``
-    default to the scene's learner."""
+    default to the scene's learner. ``warn`` hears, before the work starts, when a wrapper
+    faces so many features that it will run for hours."""
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
@@ -157,8 +159,15 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
     check_output(output, [path])
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
+    if top is not None and top > len(data.schema):
+        raise AffordError(f"--top {top} is more than the {len(data.schema)} features {art.source} has; "
+                          f"give at most {len(data.schema)}")
     kernel_name, _ = learner_settings(art, data, kernel)
     score_name = selection_score(art, data, score)
+    if warn is not None:
+        cost = wrapper_cost(data.schema, method, group_channels)
+        if cost:
+            warn(cost)
     start = time.perf_counter()
     relevance = rank_features(data, labels, method=method, top=top, seed=seed, group_channels=group_channels,
                               kernel=kernel_name, score=score_name, progress=_per_behaviour(progress, data))
@@ -169,6 +178,23 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
     return {"output": output, "seconds": round(time.perf_counter() - start, 3), "method": method, "score": score_name,
             "behaviors": {n: {"selected": r["selected"], **({"parameters": r["parameters"]} if "parameters" in r else {})}
                           for n, r in meta["relevance"].items()}}
+
+
+def wrapper_cost(schema, method: str, group_channels: bool = False, folds: int = 5) -> str | None:
+    """A sentence on what a wrapper will cost over ``schema``'s features, where it runs for
+    hours (None otherwise): backward elimination cross-validates an SVM on every remaining
+    unit at every step, some n^2/2 fits; forward selection n per feature it adds."""
+    from afford.learn.relevance import feature_groups
+
+    units = int(np.unique(feature_groups(schema)).size) if group_channels else len(schema)
+    what = "feature units" if group_channels else "features"
+    if method == "backward" and units > 60:
+        return (f"backward elimination over {units} {what} fits about {units * (units + 1) // 2 * folds:,} "
+                "cross-validated SVMs per behaviour, hours or more here; --method relieff ranks them in seconds")
+    if method == "forward" and units > 400:
+        return (f"forward selection over {units} {what} fits {units * folds:,} cross-validated SVMs per behaviour "
+                "for every feature it adds, hours here; --method relieff ranks them in seconds")
+    return None
 
 
 def train(path: str, output: str, *, kernel: str | None = None, folds: int | None = None, seed: int = 0,

@@ -120,6 +120,17 @@ def _check_counts(art: Artifact, data: Interactions) -> None:
         raise AffordError(f"{art.source} is corrupt or was edited: its manifest's behaviour counts are not its arrays'")
 
 
+def _flat(settings: dict, prefix: str = "") -> dict:
+    """Nested settings as one level of dotted keys (``world.camera.noise``)."""
+    out = {}
+    for k, v in settings.items():
+        if isinstance(v, dict):
+            out.update(_flat(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
 def check_shards(shards: list[tuple[Artifact, Interactions]]) -> tuple[list[int], tuple[int, int], int | None]:
     """Shards of one exploration, checked: the order to join them in, the episodes they
     cover together, and their seed. Each must have been explored by episodes (its manifest's
@@ -141,7 +152,11 @@ def check_shards(shards: list[tuple[Artifact, Interactions]]) -> tuple[list[int]
         if x != y:
             raise AffordError(f"{first.source} and {art.source} are of different scenes ({x} and {y})")
         if m0.get("scene") != m.get("scene"):
-            raise AffordError(f"{first.source} and {art.source} were explored with different scene settings")
+            s0, s1 = _flat(m0.get("scene") or {}), _flat(m.get("scene") or {})
+            differ = sorted(k for k in set(s0) | set(s1) if s0.get(k) != s1.get(k))
+            shown = "; ".join(f"{k}: {s0.get(k, '(unset)')} and {s1.get(k, '(unset)')}" for k in differ[:3])
+            raise AffordError(f"{first.source} and {art.source} were explored with different scene settings "
+                              f"({shown}{'; ...' if len(differ) > 3 else ''})")
         if m0.get("seed") != m.get("seed"):
             raise AffordError(f"{first.source} and {art.source} were explored with different seeds "
                               f"({m0.get('seed')} and {m.get('seed')}), so they are not shards of one exploration")

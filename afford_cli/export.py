@@ -6,6 +6,8 @@ One row per interaction. The columns, in order:
   behaviour takes (empty where this row's behaviour has none);
 * the entity the robot perceived before acting, one column per feature, named as the
   schema names it (``visibility``, ``x``, ... or ``range_min.l0.r0.c0``, ...);
+* the entity it perceived after, ``after.<feature>`` per feature, where the interactions
+  record one (not where the labels were given instead): the effect is after minus before;
 * ``result`` (the robot's own reading, by name) where the labels were given;
   ``category`` (the discovered effect category, -1 for rows pruned as rare) for an effects
   or features artefact;
@@ -65,6 +67,8 @@ def frame_of(data, labels: np.ndarray | None = None):
     frame = pd.DataFrame(columns)
     feats = pd.DataFrame(before, columns=list(data.schema.names))
     parts = [frame, feats]
+    if data.has_after:
+        parts.append(pd.DataFrame(data.after, columns=[f"after.{name}" for name in data.schema.names]))
     extra: dict[str, np.ndarray] = {}
     if data.result is not None:
         extra["result"] = np.asarray(data.result_names, dtype=object)[np.asarray(data.result, dtype=int)]

@@ -147,6 +147,7 @@ def test_shards_merge_into_the_one_shot_run_and_bad_shards_are_refused(one_shot,
     explore("gap.afford", "--episode-start", "30", "--episode-count", "10")
     explore("seed.afford", "--episode-start", "25", "--episode-count", "5", "--seed", "6")
     explore("cut.afford", "--interactions", "30")
+    explore("small.afford", "--episode-start", "25", "--episode-count", "35", "--size-max", "0.2")
     r = runner.invoke(app, ["explore", "--scene", "traverse-gaps", "--episode-start", "25", "--episode-count", "1",
                             "-o", str(tmp_path / "gaps.afford")])
     assert r.exit_code == 0, r.output
@@ -155,6 +156,7 @@ def test_shards_merge_into_the_one_shot_run_and_bad_shards_are_refused(one_shot,
             (["a.afford", "gap.afford"], "episodes 25-29 are in none of the shards"),
             (["a.afford", "seed.afford"], "different seeds (5 and 6)"),
             (["a.afford", "cut.afford"], "cut.afford is no shard"),
+            (["a.afford", "small.afford"], "different scene settings (size_range: [0.08, 0.4] and [0.08, 0.2])"),
             (["a.afford", "gaps.afford"], "different scenes (table and traverse-gaps)")):
         r = runner.invoke(app, ["merge", *[str(tmp_path / s) for s in shards], "-o", str(tmp_path / "bad.afford")])
         assert r.exit_code == 1 and message in r.output, (shards, r.output)

@@ -30,6 +30,9 @@ def test_a_csv_export_reads_into_pandas_with_the_documented_columns(pipeline, tm
     assert list(frame.columns[3:3 + len(names)]) == names  # the features, by name, in schema order
     assert len(frame) == len(data) == 480
     assert np.allclose(frame[names].to_numpy(), data.before, atol=1e-6)
+    after = [f"after.{n}" for n in names]  # what the robot perceived after, right behind
+    assert list(frame.columns[3 + len(names):3 + 2 * len(names)]) == after
+    assert np.allclose(frame[after].to_numpy() - frame[names].to_numpy(), data.effects_of(np.arange(len(data))), atol=1e-5, equal_nan=True)
     assert frame["behavior"].tolist() == [data.behavior_names[b] for b in data.behavior]
     assert np.array_equal(frame["category"].to_numpy(), art.arrays["category"])
     outcomes = np.asarray(art.manifest["outcome_labels"])[data.truth["outcome"]]

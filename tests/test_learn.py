@@ -501,3 +501,16 @@ def test_a_category_with_one_member_is_ranked_around_and_refused_as_the_only_oth
     assert fr.selected_.size >= 1
     with pytest.raises(ValueError, match="only 1 of them with two or more members"):
         AffordancePredictor(kernel="linear", cv=5, random_state=0).fit(X, y)
+
+
+def test_a_wrapper_that_would_run_for_hours_is_announced_and_a_small_one_is_not():
+    from afford.api import wrapper_cost
+    from afford.features import FeatureSchema
+
+    grid = FeatureSchema(tuple(f"cell_{i}" for i in range(3900)), ("distance",) * 3900)  # chapter 5's range grid
+    slow = wrapper_cost(grid, "backward")
+    assert slow is not None and "3900 features" in slow and "38,034,750" in slow and "relieff" in slow
+    assert "19,500" in wrapper_cost(grid, "forward")
+    assert wrapper_cost(grid, "relieff") is None
+    table = FeatureSchema(tuple(f"f{i}" for i in range(43)), ("position",) * 43)
+    assert wrapper_cost(table, "backward") is None and wrapper_cost(table, "forward") is None

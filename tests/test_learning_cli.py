@@ -53,6 +53,10 @@ def test_model_reports_features_and_predicts(pipeline):
     assert len(info["features"]) == 43 and info["kind"] == "model"
     assert set(info["behaviors"]) == {"push-forward", "push-left", "push-right", "lift"}
     assert all(len(b["selected"]) == 12 for b in info["behaviors"].values())
+    import re
+
+    gammas = re.findall(r"gamma=([0-9.e+-]+)", ok(["inspect", str(pipeline / "model.afford")]).stdout)
+    assert gammas and all(len(g.split("e")[0].replace(".", "").lstrip("0")) <= 4 for g in gammas), gammas  # four digits, not 17
     from afford.learning import forward_model, load_model
 
     loaded = load_model(str(pipeline / "model.afford"))
@@ -135,6 +139,10 @@ def _err(args):
 def test_clear_errors(pipeline, tmp_path):
     no_lift = _variant(pipeline, tmp_path, "nolift", lambda d: d.subset(np.flatnonzero(d.behavior != 3)))
     assert "no interactions of behaviour 'lift'" in _err(["cluster", str(no_lift), "-o", str(tmp_path / "x")])
+    # held-out data without one behaviour score the others and say which was left out
+    scored = json.loads(ok(["evaluate", str(pipeline / "model.afford"), str(no_lift), "--json"]).stdout)
+    assert set(scored["behaviors"]) == {"push-forward", "push-left", "push-right"}
+    assert scored["not_scored"] == {"lift": "the data hold no interactions of it"}
 
     def nan(d):
         d.entities[d.before_index[3], 5] = np.nan
@@ -161,6 +169,8 @@ def test_clear_errors(pipeline, tmp_path):
     assert "another feature schema" in _err(["evaluate", str(pipeline / "model.afford"), str(other)])
     assert "needs 'interactions'" in _err(["evaluate", str(pipeline / "model.afford"), str(pipeline / "effects.afford")])
     assert "run 'afford cluster' on it first" in _err(["train", str(pipeline / "train.afford"), "-o", str(tmp_path / "x")])
+    assert "--top 1000 is more than the 43 features" in _err(["select-features", str(pipeline / "effects.afford"),
+                                                               "-o", str(tmp_path / "x"), "--top", "1000"])
     assert not (tmp_path / "x").exists()
 
 

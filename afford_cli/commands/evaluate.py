@@ -18,22 +18,25 @@ from afford.plots import PlotDir, evaluation_plots, plot_directory, written
 from afford.reports import render_metrics
 
 
-def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
-    """Per behaviour: accuracy, log loss, Brier, ECE, confusion, reliability bins (and baselines)."""
+def evaluate_model(model, data, baselines: bool, seed: int = 0, not_scored: dict | None = None) -> dict:
+    """Per behaviour: accuracy, log loss, Brier, ECE, confusion, reliability bins (and baselines).
+
+    A behaviour the data cannot score (none of its interactions, or none of a kind the
+    model knows) is left out, with the reason in ``not_scored`` (where given); data that
+    score none of the model's behaviours are refused."""
     from afford.learn import baseline_scores, evaluate_predictions
     from afford.learn.affordances import predictor_inputs
     from afford.learn.evaluate import reliability_bins
 
     model.check_schema(data.schema, "the data")
-    missing = [n for n in model.names if n not in data.behavior_names]
-    if missing:
-        raise AffordError(f"the data hold no interactions of behaviour {missing[0]!r}, which the model predicts")
+    skipped: dict[str, str] = {}
     out = {}
     for name in model.names:
-        b = data.behavior_names.index(name)
-        rows = np.flatnonzero(data.behavior == b)
+        b = data.behavior_names.index(name) if name in data.behavior_names else -1
+        rows = np.flatnonzero(data.behavior == b) if b >= 0 else np.zeros(0, dtype=int)
         if rows.size == 0:
-            raise AffordError(f"the data hold no interactions of behaviour {name!r}")
+            skipped[name] = "the data hold no interactions of it"
+            continue
         if model.label_source == "given":
             # the robot's own reading of each held-out interaction
             if data.result is None or data.result_names != model.result_names:
@@ -48,7 +51,8 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
             y = model.effects[name].assign(data.effects_of(rows))
         known = y >= 0
         if not known.any():
-            raise AffordError(f"none of the {rows.size} {name!r} interactions falls into a category the model knows")
+            skipped[name] = f"none of its {rows.size} interactions falls into a category the model knows"
+            continue
         X = predictor_inputs(data.before_rows(rows), data.params[rows], model.selected[name], model.parameters(name))
         predictor = model.predictors[name]
         proba = predictor.predict_proba(X[known])
@@ -68,6 +72,10 @@ def evaluate_model(model, data, baselines: bool, seed: int = 0) -> dict:
             entry["baselines"] = baseline_scores(arrays[f"train_X.{name}"], arrays[f"train_y.{name}"].astype(int),
                                                  X[known], y[known], random_state=seed)
         out[name] = entry
+    if not out:
+        raise AffordError(f"the data score none of the model's behaviours ({'; '.join(f'{n}: {why}' for n, why in skipped.items())})")
+    if not_scored is not None:
+        not_scored.update(skipped)
     return out
 
 
@@ -154,7 +162,9 @@ def evaluate(
     plot_dir = plot_directory(plots) if plots is not None else None
     loaded = load_model(model)
     rows = interactions_from_artifact(read_artifact(data, "interactions"))
-    result = {"behaviors": evaluate_model(loaded, rows, baselines, seed), "n_interactions": len(rows)}
+    skipped: dict[str, str] = {}
+    result = {"behaviors": evaluate_model(loaded, rows, baselines, seed, skipped), "n_interactions": len(rows),
+              "not_scored": skipped}
     if plot_dir is not None:
         result["plots"] = evaluation_plots(result["behaviors"], plot_dir)
 
@@ -166,6 +176,8 @@ def evaluate(
                           + ", ".join(f"{n} {c}" for n, c in unknown.items()))
         console.print("over every interaction, a discarded kind predicted where P(known) < 0.5: "
                       + ", ".join(f"{n} {100 * m['accuracy_all']:.1f}% of {m['n_all']}" for n, m in result["behaviors"].items()))
+        for n, why in skipped.items():
+            console.print(f"not scored: {n} ({why})")
 
     out.result(result, render)
     if plot_dir is not None:

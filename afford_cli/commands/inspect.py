@@ -141,7 +141,8 @@ def render(console, info: dict) -> None:
                     extra.append("one effect only: predicted with certainty")
                 else:
                     extra.append(f"cross-validated accuracy {100 * cv['cv_accuracy']:.1f}% "
-                                 f"(C={cv['best_params'].get('C')}, gamma={cv['best_params'].get('gamma', '-')})")
+                                 f"(C={_short(cv['best_params'].get('C'))}, "
+                                 f"gamma={_short(cv['best_params'].get('gamma', '-'))})")
             if report.get("member_effects"):
                 me = report["member_effects"]
                 k = me.get("k") if isinstance(me.get("k"), dict) else {}
@@ -157,6 +158,11 @@ def render(console, info: dict) -> None:
                     extra.append("effect within a category, per channel: " + "; ".join(parts))
             for line in extra:
                 console.print(f"  {line}")
+
+
+def _short(value) -> str:
+    """A hyperparameter as a reader wants it: four significant digits (``0.00833``, ``1000``)."""
+    return f"{value:.4g}" if isinstance(value, float) else str(value)
 
 
 def _channels(features: list[dict]) -> list[tuple[str, list[str]]]:

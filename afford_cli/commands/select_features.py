@@ -43,7 +43,8 @@ def select_features(
     with out.progress(f"selecting features ({method.value})", None) as update:
         result = run(path, output, method=method.value, top=top, group_channels=group_channels,
                      kernel=kernel.value if kernel is not None else None,
-                     score=None if score is None else score.value.replace("-", "_"), seed=seed, progress=update)
+                     score=None if score is None else score.value.replace("-", "_"), seed=seed, progress=update,
+                     warn=out.warn)
 
     def render(console):
         table = Table(title=f"relevant features ({method.value})")
