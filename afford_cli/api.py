@@ -198,27 +198,31 @@ def wrapper_cost(schema, method: str, group_channels: bool = False, folds: int =
 
 
 def train(path: str, output: str, *, kernel: str | None = None, folds: int | None = None, seed: int = 0,
-          progress: Callable[[int, int], None] | None = None) -> dict:
+          search_rows: int | None = None, progress: Callable[[int, int], None] | None = None) -> dict:
     """Train each behaviour's calibrated predictor of its labels: reads features, effects or
     interactions with given results, writes ``model``; returns the summary ``afford train
-    --json`` prints. ``kernel`` and ``folds`` default to the scene's learner."""
+    --json`` prints. ``kernel``, ``folds`` and ``search_rows`` (the rows per behaviour the
+    grid search cross-validates on, a stratified sample; None: every row) default to the
+    scene's learner."""
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
     from afford.learn.affordances import train_known, train_members, train_predictors
-    from afford.learning import learner_settings, model_members, read_selection
+    from afford.learning import learner_settings, model_members, read_selection, search_rows_setting
 
     check_output(output, [path])
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, effects = read_effects(art, data)
     selected = read_selection(art, data)
     kernel_name, n_folds = learner_settings(art, data, kernel, folds)
+    rows = search_rows_setting(art, data, search_rows)
     start = time.perf_counter()
     predictors = train_predictors(data, labels, selected, kernel=kernel_name, folds=n_folds, seed=seed,
-                                  progress=_per_behaviour(progress, data))
-    known = train_known(data, labels, seed=seed) if effects is not None else None
+                                  search_rows=rows, progress=_per_behaviour(progress, data))
+    known = train_known(data, labels, seed=seed, search_rows=rows) if effects is not None else None
     members = train_members(data, labels, seed=seed) if effects is not None else None
-    settings = {"kernel": kernel_name, "folds": n_folds, "selection": art.kind}
+    settings = {"kernel": kernel_name, "folds": n_folds, "selection": art.kind,
+                **({"search_rows": rows} if rows is not None else {})}
     arrays, meta, blobs = model_members(art, data, labels, effects, selected, predictors, settings, known, members)
     write_artifact(output, artifact_bytes("model", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     return {"output": output, "seconds": round(time.perf_counter() - start, 3), "kernel": kernel_name,

@@ -20,7 +20,7 @@ from afford.learn import TRUSTED_TYPES as PREDICTOR_TYPES
 
 __all__ = [
     "TRUSTED", "read_rows", "effects_members", "read_effects", "features_members", "read_selection",
-    "category_report", "model_members", "LoadedModel", "load_model",
+    "category_report", "model_members", "LoadedModel", "load_model", "search_rows_setting",
 ]
 
 #: Every type a model file may hold; anything else is refused on load.
@@ -213,6 +213,18 @@ def learner_settings(art: Artifact | None, data: Interactions | dict, kernel: st
         raise AffordError(f"{art.source if art else 'the data'} asks for a number of folds that is not a number; "
                           "give --folds") from None
     return kernel, folds
+
+
+def search_rows_setting(art: Artifact | None, data: Interactions, search_rows: int | None = None) -> int | None:
+    """Rows the grid search may cross-validate on, per behaviour: the number given, else the
+    scene's (``learner`` in its configuration, ``"search_rows"``), else every row (None)."""
+    value = search_rows if search_rows is not None else _scene_learner(data.scene).get("search_rows")
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int) or value < 10:
+        raise AffordError(f"{art.source if art else 'the data'} asks the grid search for {value!r} rows, "
+                          "not a whole number of at least 10; give --search-rows")
+    return int(value)
 
 
 SCORES = ("accuracy", "log_loss")

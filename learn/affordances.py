@@ -218,7 +218,8 @@ def prefix_estimator(kernel: str):
     return make_pipeline(StandardScaler(), LinearSVC(C=0.01, dual=False, max_iter=20000))
 
 
-def train_known(data: Interactions, labels: np.ndarray, *, seed: int = 0, min_rows: int = 10) -> dict:
+def train_known(data: Interactions, labels: np.ndarray, *, seed: int = 0, min_rows: int = 10,
+                search_rows: int | None = None) -> dict:
     """Per behaviour, P(the effect is of a kind the categories kept | object, alpha).
 
     Frequency pruning drops rare effects with their members, so a predictor trained on the
@@ -241,7 +242,8 @@ def train_known(data: Interactions, labels: np.ndarray, *, seed: int = 0, min_ro
             out[name] = None
             continue
         X = predictor_inputs(data.before_rows(rows), data.params[rows], known_columns(data.schema), parameters_of(data, b))
-        out[name] = AffordancePredictor(kernel="rbf", calibration="sigmoid", random_state=behaviour_seed(seed, b)).fit(X, known)
+        out[name] = AffordancePredictor(kernel="rbf", calibration="sigmoid", search_rows=search_rows,
+                                        random_state=behaviour_seed(seed, b)).fit(X, known)
     return out
 
 
@@ -278,11 +280,12 @@ def known_columns(schema) -> np.ndarray:
 
 def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str, np.ndarray], *,
                      kernel: str = "rbf", folds: int = 3, seed: int = 0, n_jobs: int | None = None,
-                     progress: Callable[[int], None] | None = None) -> dict:
+                     search_rows: int | None = None, progress: Callable[[int], None] | None = None) -> dict:
     """One calibrated predictor per behaviour; ``{name: AffordancePredictor}``.
 
     ``folds``: the cross-validation that chooses C (and gamma) and reports the accuracy
-    (3 at the table; the thesis's chapter 5 reported 5-fold cross-validation)."""
+    (3 at the table; the thesis's chapter 5 reported 5-fold cross-validation).
+    ``search_rows``: that search sees a stratified sample of at most this many rows."""
     out = {}
     _check_some_differ(data, labels, "predict")
     for b, name in enumerate(data.behavior_names):
@@ -294,7 +297,7 @@ def train_predictors(data: Interactions, labels: np.ndarray, selected: dict[str,
             rows = rows[np.isin(y, values[counts == counts.max()][:1])]
             y = labels[rows]
         X = predictor_inputs(data.before_rows(rows), data.params[rows], selected[name], parameters_of(data, b))
-        out[name] = AffordancePredictor(kernel=kernel, cv=folds, n_jobs=n_jobs,
+        out[name] = AffordancePredictor(kernel=kernel, cv=folds, n_jobs=n_jobs, search_rows=search_rows,
                                         random_state=behaviour_seed(seed, b)).fit(X, y)
         if progress is not None:
             progress(b + 1)

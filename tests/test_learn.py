@@ -328,6 +328,25 @@ def test_calibrated_probabilities_match_truth():
     assert 0.7 < model.cv_report_["cv_accuracy"] < 0.9  # the Bayes rate here is about 0.8
 
 
+def test_a_grid_search_on_a_sample_keeps_every_category_and_still_calibrates_on_every_row():
+    x, y, _ = noisy_logistic(3000, 0)
+    y = y.copy()
+    y[:3] = 7  # a rare category: the sample must keep it (two members at least)
+    sampled = AffordancePredictor(random_state=0, search_rows=600).fit(x, y)
+    report = sampled.cv_report_
+    assert 600 <= report["search_rows"] <= 610  # each category's share, rounded, and the rare one's two
+    assert sampled.classes_.tolist() == [0, 1, 7]
+    full = AffordancePredictor(random_state=0).fit(x, y)
+    assert full.cv_report_["search_rows"] == 3000
+    xt, _, pt = noisy_logistic(2000, 1)
+    # the machine and its calibration saw every row: as close to the truth as the full search
+    err = [np.abs(m.predict_proba(xt)[:, 1] - pt).mean() for m in (sampled, full)]
+    assert err[0] < 0.07 and err[0] < err[1] + 0.02
+    # the same seed, the same sample: the same model
+    again = AffordancePredictor(random_state=0, search_rows=600).fit(x, y)
+    assert np.array_equal(again.predict_proba(xt), sampled.predict_proba(xt))
+
+
 def test_predictor_copes_with_tiny_categories():
     rng = np.random.default_rng(3)
     X = rng.normal(size=(300, 3))

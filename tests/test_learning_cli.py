@@ -331,3 +331,14 @@ def test_a_behaviour_that_never_changed_anything_trains_as_certain_beside_the_ot
     assert out["behaviors"]["lift"]["n_categories"] > 1
     pred = json.loads(ok(["predict", m, "--seed", "3", "--json"]).stdout)
     assert all(o["behaviors"]["push-forward"]["probability"] == 1.0 for o in pred["objects"] if o["visible"])
+
+
+def test_train_can_choose_c_and_gamma_on_a_sample_and_records_it(pipeline, tmp_path):
+    out = tmp_path / "m.afford"
+    ok(["train", str(pipeline / "features.afford"), "-o", str(out), "--search-rows", "60"])
+    art = read_artifact(str(out))
+    assert art.manifest["training"]["search_rows"] == 60
+    cv = art.manifest["cv"]
+    rows = {n: sum(r["class_counts"].values()) for n, r in cv.items()}
+    assert all(rows[n] > 60 for n in cv)  # each behaviour has more rows than the sample
+    assert all(r["search_rows"] <= 60 + 2 * len(r["class_counts"]) for r in cv.values())

@@ -17,6 +17,7 @@ def train(
     output: OutputPath,
     kernel: KernelOption = None,
     folds: Annotated[Optional[int], typer.Option("--folds", min=2, max=10, help="Cross-validation folds that choose C (and gamma) and report accuracy; by default the scene's (5 for the traverse scenes, 3 at the table).")] = None,
+    search_rows: Annotated[Optional[int], typer.Option("--search-rows", min=10, help="Choose C and gamma by cross-validation on a stratified sample of at most this many rows per behaviour, then calibrate and fit on every row (libsvm's cost grows with the square of the rows); by default the scene's (grasp: 3000), else every row.")] = None,
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
@@ -27,7 +28,7 @@ def train(
     out = Output(json, stdout_busy=writes_stdout(output))
     with out.progress("training predictors", None) as update:
         result = run(path, output, kernel=kernel.value if kernel is not None else None, folds=folds, seed=seed,
-                     progress=update)
+                     search_rows=search_rows, progress=update)
 
     def render(console):
         table = Table(title=f"trained predictors ({result['kernel']} SVM)")
