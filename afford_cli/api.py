@@ -142,19 +142,20 @@ def _per_behaviour(progress, data):
 
 def select_features(path: str, output: str, *, method: str = "relieff", top: int | None = None,
                     group_channels: bool = False, kernel: str | None = None, score: str | None = None,
-                    seed: int = 0, progress: Callable[[int, int], None] | None = None,
+                    seed: int = 0, search_rows: int | None = None, progress: Callable[[int, int], None] | None = None,
                     warn: Callable[[str], None] | None = None) -> dict:
     """Rank the features by relevance to each behaviour's labels (ReliefF, Algorithm 3, or a
     wrapper) and keep the best: reads effects or interactions with given results, writes
     ``features``; returns the summary ``afford select-features --json`` prints. ``score``
     (``"accuracy"`` or ``"log_loss"``: what ReliefF's ranking cut scores) and ``kernel``
-    default to the scene's learner. ``warn`` hears, before the work starts, when a wrapper
-    faces so many features that it will run for hours."""
+    default to the scene's learner, and so does ``search_rows`` (the rows a behaviour the
+    ranking's cut cross-validates on, a stratified sample; None: every row). ``warn`` hears,
+    before the work starts, when a wrapper faces so many features that it will run for hours."""
     import time
 
     from afford.artifacts import artifact_bytes, check_output, write_artifact
     from afford.learn.affordances import rank_features
-    from afford.learning import features_members, learner_settings, selection_score
+    from afford.learning import features_members, learner_settings, search_rows_setting, selection_score
 
     check_output(output, [path])
     art, data = read_rows(path, ("interactions", "effects", "features"))
@@ -169,10 +170,12 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
         if cost:
             warn(cost)
     start = time.perf_counter()
+    rows = search_rows_setting(art, data, search_rows)
     relevance = rank_features(data, labels, method=method, top=top, seed=seed, group_channels=group_channels,
-                              kernel=kernel_name, score=score_name, progress=_per_behaviour(progress, data))
+                              kernel=kernel_name, score=score_name, search_rows=rows,
+                              progress=_per_behaviour(progress, data))
     settings = {"method": method, "top": top, "group_channels": group_channels, "kernel": kernel_name,
-                "score": score_name}
+                "score": score_name, **({"search_rows": rows} if rows is not None else {})}
     arrays, meta, blobs = features_members(art, data, relevance, settings)
     write_artifact(output, artifact_bytes("features", arrays, meta, parents=[art.parent_ref()], seed=seed, blobs=blobs))
     return {"output": output, "seconds": round(time.perf_counter() - start, 3), "method": method, "score": score_name,

@@ -121,12 +121,13 @@ def effect_categories(schema, E: np.ndarray, X: np.ndarray, b: int, *, method: s
 
 def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "relieff", top: int | None = None,
                   seed: int = 0, group_channels: bool = False, kernel: str = "rbf", score: str = "accuracy",
-                  progress: Callable[[int], None] | None = None) -> dict:
+                  search_rows: int | None = None, progress: Callable[[int], None] | None = None) -> dict:
     """Feature relevance per behaviour (on rows with a kept category); ``{name: FeatureRelevance}``.
 
     ReliefF's ranking is cut where cross-validation of the SVM ``train`` will fit says
     (``kernel``: an RBF machine, or a linear one as chapter 5's), by its accuracy or, with
-    ``score="log_loss"``, by its calibrated probabilities' log loss."""
+    ``score="log_loss"``, by its calibrated probabilities' log loss; on a stratified sample
+    of at most ``search_rows`` rows a behaviour, where given."""
     out = {}
     groups = feature_groups(data.schema) if group_channels else None
     _check_some_differ(data, labels, "tell apart")
@@ -144,7 +145,8 @@ def rank_features(data: Interactions, labels: np.ndarray, *, method: str = "reli
             if g is not None:
                 g = np.concatenate([g, _parameter_units(params, int(g.max()) + 1)])
         fr = FeatureRelevance(method=method, top=top, feature_groups=g, random_state=behaviour_seed(seed, b),
-                              estimator=prefix_estimator(kernel) if method == "relieff" else None, scoring=score)
+                              estimator=prefix_estimator(kernel) if method == "relieff" else None, scoring=score,
+                              search_rows=search_rows)
         out[name] = _split_parameters(fr.fit(X, y), d, params)
         if out[name].selected_.size == 0 and not params:
             # One effect only (nothing to tell apart): the predictor will be certain of it

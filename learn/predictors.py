@@ -41,7 +41,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from afford.features.errors import DataError
-from afford.learn.validation import check_finite
+from afford.learn.validation import check_finite, stratified_sample
 
 __all__ = ["AffordancePredictor", "TRUSTED_TYPES", "PARTS"]
 
@@ -218,20 +218,9 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         return PredefinedSplit(test_fold)
 
     def _search_sample(self, y_idx: np.ndarray) -> np.ndarray | None:
-        """Sorted rows the grid search sees: a stratified sample of ``search_rows`` (None: all).
-        Each category contributes in proportion to its size, and at least two members
-        (or all it has), so no category the folds can hold out is lost."""
-        if self.search_rows is None or y_idx.size <= self.search_rows:
-            return None
-        rng = np.random.default_rng(check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
-        share = self.search_rows / y_idx.size
-        picked = []
-        for c in range(int(y_idx.max()) + 1):
-            rows = np.flatnonzero(y_idx == c)
-            if rows.size:
-                take = min(rows.size, max(2, int(round(rows.size * share))))
-                picked.append(rng.choice(rows, take, replace=False))
-        return np.sort(np.concatenate(picked))
+        """Sorted rows the grid search sees: a stratified sample of ``search_rows`` (None: all)."""
+        return stratified_sample(y_idx, self.search_rows,
+                                 check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
 
     @staticmethod
     def _simplest_good(results) -> int:

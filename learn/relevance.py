@@ -40,7 +40,7 @@ from sklearn.utils.validation import check_array, check_is_fitted, validate_data
 
 from afford.features.errors import DataError
 from afford.features.schema import FeatureSchema
-from afford.learn.validation import check_finite
+from afford.learn.validation import check_finite, stratified_sample
 
 __all__ = ["FeatureRelevance", "backward_elimination", "feature_groups", "forward_selection", "ranking_prefix", "relieff"]
 
@@ -568,6 +568,10 @@ class FeatureRelevance(BaseEstimator):
     scoring : {"accuracy", "log_loss"}, default="accuracy"
         What ReliefF's prefix cut scores (:func:`ranking_prefix`); the wrappers count
         accuracy.
+    search_rows : int or None, default=None
+        ReliefF's prefix cut cross-validates on a stratified sample of at most this many
+        rows (:func:`afford.learn.validation.stratified_sample`); the ranking reads every
+        row. None: every row.
 
     Attributes
     ----------
@@ -608,11 +612,13 @@ class FeatureRelevance(BaseEstimator):
         "n_jobs": [numbers.Integral, None],
         "random_state": ["random_state"],
         "scoring": [StrOptions({"accuracy", "log_loss"})],
+        "search_rows": [Interval(numbers.Integral, 10, None, closed="left"), None],
     }
 
     def __init__(self, method="relieff", top=None, n_samples=1000, n_neighbors=10, estimator=None, cv=5,
                  feature_groups=None, tol=None, max_features=None, n_jobs=None, random_state=None,
-                 scoring="accuracy"):
+                 scoring="accuracy", search_rows=None):
+        self.search_rows = search_rows
         self.method = method
         self.top = top
         self.n_samples = n_samples
@@ -655,7 +661,11 @@ class FeatureRelevance(BaseEstimator):
             self.scores_ = relieff(X, y, self.n_samples, self.n_neighbors, self.random_state)
             self.ranking_ = np.argsort(-self.scores_, kind="stable")
             if self.top is None:
-                k, self.path_ = ranking_prefix(X, y, self.ranking_, self.estimator, min(self.cv, 3),
+                rows = None if self.search_rows is None else stratified_sample(
+                    np.unique(y, return_inverse=True)[1], self.search_rows,
+                    check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
+                Xs, ys = (X, y) if rows is None else (X[rows], y[rows])
+                k, self.path_ = ranking_prefix(Xs, ys, self.ranking_, self.estimator, min(self.cv, 3),
                                                self.random_state, self.n_jobs, self.scoring)
                 self.selected_ = self.ranking_[:k]
             else:

@@ -248,6 +248,20 @@ def test_relieff_ranks_planted_features_first():
     assert np.array_equal(fr.transform(X), X[:, fr.selected_])
 
 
+def test_relieffs_cut_on_a_sample_scores_that_sample_and_keeps_the_planted_features(monkeypatch):
+    import afford.learn.relevance as relevance
+
+    X, y = relevance_data()
+    seen = []
+    real = relevance.ranking_prefix
+    monkeypatch.setattr(relevance, "ranking_prefix", lambda X, y, *a: seen.append(len(y)) or real(X, y, *a))
+    fr = FeatureRelevance(random_state=0, search_rows=len(y) // 2).fit(X, y)
+    assert seen == [pytest.approx(len(y) // 2, abs=3)]  # the cut saw the sample, about half
+    assert set(fr.selected_) == {2, 7}  # and still keeps what matters
+    FeatureRelevance(random_state=0, search_rows=10 * len(y)).fit(X, y)
+    assert seen[-1] == len(y)  # fewer rows than the sample: every row
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_a_log_loss_cut_keeps_a_feature_that_makes_a_rare_effect_likelier(seed):
     """Feature 0 makes the rare effect possible (40 % of the time, where x0 > 0.85) but never

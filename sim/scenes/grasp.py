@@ -73,10 +73,11 @@ class GraspScene(TableScene):
     #: seldom the likeliest effect, so the accuracy cut kept no entity feature for the
     #: precision grasp, whose predictor then said the majority; cut by log loss it keeps 19
     #: and beats the majority (83.6 % against 80.9 % held out, 10 000 interactions of seed 1).
-    #: ``afford train``'s grid search cross-validates on at most 3000 rows a behaviour (a
-    #: stratified sample; calibration and the final machine see every row): on 30 000
-    #: interactions, 6000 rows a behaviour, the search over every row did not finish in 27
-    #: minutes. Below 15 000 interactions nothing changes.
+    #: ``afford train``'s grid search and ``select-features``' ranking cut cross-validate on
+    #: at most 3000 rows a behaviour (a stratified sample; calibration, the final machine
+    #: and the ReliefF ranking see every row): on 30 000 interactions, 6000 rows a
+    #: behaviour, the search over every row did not finish in 27 minutes. Below 15 000
+    #: interactions nothing changes.
     learner = {"score": "log_loss", "search_rows": 3000}
 
     def __init__(self, config: GraspSceneConfig | None = None):
