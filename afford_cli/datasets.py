@@ -151,8 +151,10 @@ def check_shards(shards: list[tuple[Artifact, Interactions]]) -> tuple[list[int]
         x, y = m0.get("scene", {}).get("name"), m.get("scene", {}).get("name")
         if x != y:
             raise AffordError(f"{first.source} and {art.source} are of different scenes ({x} and {y})")
-        if m0.get("scene") != m.get("scene"):
-            s0, s1 = _flat(m0.get("scene") or {}), _flat(m.get("scene") or {})
+        # the learner's defaults (how to cluster and train) are not how the data were explored
+        explored0, explored1 = ({k: v for k, v in (x.get("scene") or {}).items() if k != "learner"} for x in (m0, m))
+        if explored0 != explored1:
+            s0, s1 = _flat(explored0), _flat(explored1)
             differ = sorted(k for k in set(s0) | set(s1) if s0.get(k) != s1.get(k))
             shown = "; ".join(f"{k}: {s0.get(k, '(unset)')} and {s1.get(k, '(unset)')}" for k in differ[:3])
             raise AffordError(f"{first.source} and {art.source} were explored with different scene settings "

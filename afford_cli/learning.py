@@ -8,6 +8,8 @@ matrices the baselines need, cross-validation reports and category reports).
 
 from __future__ import annotations
 
+import numbers
+
 from typing import Any
 
 import numpy as np
@@ -221,9 +223,11 @@ def search_rows_setting(art: Artifact | None, data: Interactions, search_rows: i
     value = search_rows if search_rows is not None else _scene_learner(data.scene).get("search_rows")
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, int) or value < 10:
-        raise AffordError(f"{art.source if art else 'the data'} asks the grid search for {value!r} rows, "
-                          "not a whole number of at least 10; give --search-rows")
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 10:
+        if search_rows is not None:
+            raise AffordError(f"search_rows {value!r} is not a whole number of at least 10")
+        raise AffordError(f"{art.source if art else 'the data'} asks the grid search for {value!r} rows, not a "
+                          "whole number of at least 10; give --search-rows")
     return int(value)
 
 

@@ -180,6 +180,9 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         "random_state": ["random_state"],
     }
 
+    #: Predictors saved before the option existed lack it: they searched every row.
+    search_rows = None
+
     def __init__(self, kernel="rbf", C_grid=(0.1, 1.0, 10.0, 100.0, 1000.0), gamma_grid=None, cv=3, choice="one-se",
                  calibration="temperature", ensemble=False, search_rows=None, n_jobs=None, random_state=None):
         self.ensemble = ensemble
@@ -218,7 +221,11 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
         return PredefinedSplit(test_fold)
 
     def _search_sample(self, y_idx: np.ndarray) -> np.ndarray | None:
-        """Sorted rows the grid search sees: a stratified sample of ``search_rows`` (None: all)."""
+        """Sorted rows the grid search sees: a stratified sample of ``search_rows`` (None: all).
+        The random state is drawn from only when there is a sample to take, so a shared
+        generator moves as it did before the option existed."""
+        if self.search_rows is None or y_idx.size <= self.search_rows:
+            return None
         return stratified_sample(y_idx, self.search_rows,
                                  check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
 

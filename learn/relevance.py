@@ -615,6 +615,9 @@ class FeatureRelevance(BaseEstimator):
         "search_rows": [Interval(numbers.Integral, 10, None, closed="left"), None],
     }
 
+    #: Rankings saved before the option existed lack it: their cut saw every row.
+    search_rows = None
+
     def __init__(self, method="relieff", top=None, n_samples=1000, n_neighbors=10, estimator=None, cv=5,
                  feature_groups=None, tol=None, max_features=None, n_jobs=None, random_state=None,
                  scoring="accuracy", search_rows=None):
@@ -661,7 +664,7 @@ class FeatureRelevance(BaseEstimator):
             self.scores_ = relieff(X, y, self.n_samples, self.n_neighbors, self.random_state)
             self.ranking_ = np.argsort(-self.scores_, kind="stable")
             if self.top is None:
-                rows = None if self.search_rows is None else stratified_sample(
+                rows = None if self.search_rows is None or len(y) <= self.search_rows else stratified_sample(
                     np.unique(y, return_inverse=True)[1], self.search_rows,
                     check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
                 Xs, ys = (X, y) if rows is None else (X[rows], y[rows])

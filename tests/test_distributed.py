@@ -138,6 +138,17 @@ def test_shards_merge_into_the_one_shot_run_and_bad_shards_are_refused(one_shot,
     r = runner.invoke(app, ["merge", str(tmp_path / "b.afford"), str(tmp_path / "a.afford"), "-o", str(tmp_path / "m.afford")])
     assert r.exit_code == 0, r.output
     assert arrays(tmp_path / "m.afford") == arrays(one_shot)
+    # a shard whose scene's learner defaults differ (an afford that trains otherwise) explored the same data
+    from afford.artifacts import artifact_bytes, read_artifact, write_artifact
+
+    b = read_artifact(str(tmp_path / "b.afford"))
+    own = ("format", "kind", "schema_version", "afford_version", "created", "command", "seed", "parents", "members")
+    meta = {k: v for k, v in b.manifest.items() if k not in own}
+    meta["scene"] = {**meta["scene"], "learner": {"search_rows": 3000}}
+    write_artifact(str(tmp_path / "b2.afford"), artifact_bytes("interactions", dict(b.arrays), meta, seed=b.manifest["seed"],
+                                                               parents=b.manifest["parents"], blobs=dict(b.blobs)))
+    r = runner.invoke(app, ["merge", str(tmp_path / "a.afford"), str(tmp_path / "b2.afford"), "-o", str(tmp_path / "m3.afford")])
+    assert r.exit_code == 0, r.output
     # merged shards are a shard themselves: the merged file merges on
     explore("c.afford", "--episode-start", "60", "--episode-count", "5")
     r = runner.invoke(app, ["merge", str(tmp_path / "m.afford"), str(tmp_path / "c.afford"), "-o", str(tmp_path / "m2.afford"), "--json"])

@@ -342,3 +342,13 @@ def test_train_can_choose_c_and_gamma_on_a_sample_and_records_it(pipeline, tmp_p
     rows = {n: sum(r["class_counts"].values()) for n, r in cv.items()}
     assert all(rows[n] > 60 for n in cv)  # each behaviour has more rows than the sample
     assert all(r["search_rows"] <= 60 + 2 * len(r["class_counts"]) for r in cv.values())
+
+
+def test_search_rows_takes_any_whole_number_and_refuses_the_rest_in_one_sentence():
+    from afford.errors import AffordError
+    from afford.learning import search_rows_setting
+
+    assert search_rows_setting(None, None, np.int64(500)) == 500  # numpy's integers from the Python API too
+    for bad in (True, 2.5, 5):
+        with pytest.raises(AffordError, match="not a whole number of at least 10"):
+            search_rows_setting(None, None, bad)
