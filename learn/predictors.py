@@ -220,15 +220,6 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
                 test_fold[rows[test]] = i
         return PredefinedSplit(test_fold)
 
-    def _search_sample(self, y_idx: np.ndarray) -> np.ndarray | None:
-        """Sorted rows the grid search sees: a stratified sample of ``search_rows`` (None: all).
-        The random state is drawn from only when there is a sample to take, so a shared
-        generator moves as it did before the option existed."""
-        if self.search_rows is None or y_idx.size <= self.search_rows:
-            return None
-        return stratified_sample(y_idx, self.search_rows,
-                                 check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
-
     @staticmethod
     def _simplest_good(results) -> int:
         """Index of the smoothest setting within one standard error of the best accuracy.
@@ -291,7 +282,7 @@ class AffordancePredictor(ClassifierMixin, BaseEstimator):
             if gammas is None:
                 gammas = [f / X.shape[1] for f in _GAMMA_FACTORS]
             grid[prefix + "gamma"] = [float(g) for g in gammas]
-        sample = self._search_sample(y_idx)
+        sample = stratified_sample(y_idx, self.search_rows, self.random_state)
         search_folds = folds if sample is None else self._folds(y_idx[sample])
         search = GridSearchCV(base, grid, scoring="accuracy", cv=search_folds, refit=False, n_jobs=self.n_jobs,
                               error_score="raise")

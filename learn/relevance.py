@@ -664,9 +664,7 @@ class FeatureRelevance(BaseEstimator):
             self.scores_ = relieff(X, y, self.n_samples, self.n_neighbors, self.random_state)
             self.ranking_ = np.argsort(-self.scores_, kind="stable")
             if self.top is None:
-                rows = None if self.search_rows is None or len(y) <= self.search_rows else stratified_sample(
-                    np.unique(y, return_inverse=True)[1], self.search_rows,
-                    check_random_state(self.random_state).randint(np.iinfo(np.int32).max))
+                rows = stratified_sample(np.unique(y, return_inverse=True)[1], self.search_rows, self.random_state)
                 Xs, ys = (X, y) if rows is None else (X[rows], y[rows])
                 k, self.path_ = ranking_prefix(Xs, ys, self.ranking_, self.estimator, min(self.cv, 3),
                                                self.random_state, self.n_jobs, self.scoring)

@@ -21,14 +21,18 @@ def check_finite(X: np.ndarray, what: str = "X") -> None:
         )
 
 
-def stratified_sample(y_idx: np.ndarray, n: int | None, seed: int) -> np.ndarray | None:
+def stratified_sample(y_idx: np.ndarray, n: int | None, random_state) -> np.ndarray | None:
     """Sorted rows of a stratified sample of about ``n`` of the labels ``y_idx`` (0-based
     ids), or None when ``n`` is None or there are no more rows than that. Each category
     gives in proportion to its size, and at least two members (or all it has), so none
-    that cross-validation could hold out is lost."""
+    that cross-validation could hold out is lost. ``random_state`` (a seed, a
+    ``RandomState`` or None) is drawn from only when there is a sample to take, so a shared
+    generator moves as it would without the sample."""
     if n is None or y_idx.size <= n:
         return None
-    rng = np.random.default_rng(seed)
+    from sklearn.utils import check_random_state
+
+    rng = np.random.default_rng(check_random_state(random_state).randint(np.iinfo(np.int32).max))
     share = n / y_idx.size
     picked = []
     for c in range(int(y_idx.max()) + 1):

@@ -364,14 +364,16 @@ def test_a_grid_search_on_a_sample_keeps_every_category_and_still_calibrates_on_
 def test_a_predictor_saved_before_search_rows_existed_still_clones_and_an_unsampled_fit_draws_nothing():
     from sklearn.base import clone
 
+    from afford.learn.validation import stratified_sample
+
     x, y, _ = noisy_logistic(300, 0)
     old = AffordancePredictor(random_state=0).fit(x, y)
     del old.search_rows  # as a predictor written before the option has no such attribute
     assert old.get_params()["search_rows"] is None and clone(old).search_rows is None
     rs = np.random.RandomState(0)
     before = rs.get_state()[1].copy()
-    assert AffordancePredictor(random_state=rs, search_rows=None)._search_sample(y) is None
-    assert AffordancePredictor(random_state=rs, search_rows=10 * len(y))._search_sample(y) is None
+    assert stratified_sample(y, None, rs) is None
+    assert stratified_sample(y, 10 * len(y), rs) is None
     assert np.array_equal(rs.get_state()[1], before)  # a shared generator moves as it did before
 
 
