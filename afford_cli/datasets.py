@@ -22,14 +22,19 @@ def behaviour_counts(data: Interactions) -> dict[str, int]:
 
 
 def outcome_table(data: Interactions) -> dict[str, dict[str, dict[str, int]]]:
-    """``{behaviour: {shape: {label: count}}}`` from ground truth."""
+    """``{behaviour: {shape: {label: count}}}`` from ground truth, over the shapes the data
+    hold (a scene drawing from a shared list of shapes, as the crane does, does not list
+    the ones it never places)."""
     table: dict[str, dict[str, dict[str, int]]] = {}
     if "outcome" not in data.truth or "shape" not in data.truth:
         return table
     keys = Counter(zip(data.behavior.tolist(), data.truth["shape"].tolist(), data.truth["outcome"].tolist()))
+    present = set(data.truth["shape"].tolist())
     for b, name in enumerate(data.behavior_names):
         table[name] = {}
         for s, shape in enumerate(data.shapes):
+            if s not in present:
+                continue
             table[name][shape] = {label: int(keys.get((b, s, o), 0)) for o, label in enumerate(data.outcome_names)}
     return table
 

@@ -78,3 +78,11 @@ def test_comparison_goals_on_unknown_features_and_bfs_past_its_depth_say_so(expl
     assert not out["plan"]["found"] and out["plan"]["reason"] == "no plan of at most 2 steps reaches the goal"
     fails(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--seed", "3", "--goal", "*:r_b>400", "--search", "bfs",
            "--max-depth", "9"], code=2)
+
+
+def test_inspect_lists_only_the_shapes_the_scene_places(explored):
+    """The crane draws from the solid shapes the table shares with the hand's mug; its
+    ground-truth table must not list a mug it never placed."""
+    info = json.loads(ok(["inspect", str(explored / "i.afford"), "--json"]).stdout)
+    assert set(info["outcomes"]["lift"]) == {"box", "cylinder", "lying-cylinder", "sphere"}
+    assert sum(c for labels in info["outcomes"]["lift"].values() for c in labels.values()) == info["counts"]["lift"]
