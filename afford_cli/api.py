@@ -277,9 +277,10 @@ def explore(scene, *, episodes: int | None = None, interactions: int | None = No
     if journal is not None:
         from pathlib import Path
 
+        from afford.datasets import explored_settings
         from afford.journal import Journal
 
-        identity = {"scene": sc.describe(), "seed": seed, "episodes": episodes, "interactions": interactions,
+        identity = {"scene": explored_settings(sc.describe()), "seed": seed, "episodes": episodes, "interactions": interactions,
                     "episode_start": episode_start, "max_steps": max_steps}
         book = Journal.start(Path(journal), identity, resume)
     try:

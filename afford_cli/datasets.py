@@ -11,7 +11,8 @@ from afford.artifacts import Artifact
 from afford.errors import AffordError
 from afford.features import OUTCOMES, FeatureSchema, Interactions
 
-__all__ = ["interactions_members", "interactions_from_artifact", "outcome_table", "behaviour_counts", "check_shards"]
+__all__ = ["interactions_members", "interactions_from_artifact", "outcome_table", "behaviour_counts", "check_shards",
+           "explored_settings", "settings_difference"]
 
 _TRUTH = "truth_"
 
@@ -125,6 +126,21 @@ def _check_counts(art: Artifact, data: Interactions) -> None:
         raise AffordError(f"{art.source} is corrupt or was edited: its manifest's behaviour counts are not its arrays'")
 
 
+def explored_settings(scene: dict | None) -> dict:
+    """A scene's description without its learner defaults (how to cluster and train): what
+    decides the rows an exploration makes, which shards to merge and a journal to resume
+    must share."""
+    return {k: v for k, v in (scene or {}).items() if k != "learner"}
+
+
+def settings_difference(a: dict, b: dict, most: int = 3) -> str:
+    """The first ``most`` settings in which ``a`` and ``b`` differ, as ``key: x and y; ...``."""
+    s0, s1 = _flat(a), _flat(b)
+    differ = sorted(k for k in set(s0) | set(s1) if s0.get(k) != s1.get(k))
+    shown = "; ".join(f"{k}: {s0.get(k, '(unset)')} and {s1.get(k, '(unset)')}" for k in differ[:most])
+    return shown + ("; ..." if len(differ) > most else "")
+
+
 def _flat(settings: dict, prefix: str = "") -> dict:
     """Nested settings as one level of dotted keys (``world.camera.noise``)."""
     out = {}
@@ -156,14 +172,10 @@ def check_shards(shards: list[tuple[Artifact, Interactions]]) -> tuple[list[int]
         x, y = m0.get("scene", {}).get("name"), m.get("scene", {}).get("name")
         if x != y:
             raise AffordError(f"{first.source} and {art.source} are of different scenes ({x} and {y})")
-        # the learner's defaults (how to cluster and train) are not how the data were explored
-        explored0, explored1 = ({k: v for k, v in (x.get("scene") or {}).items() if k != "learner"} for x in (m0, m))
+        explored0, explored1 = explored_settings(m0.get("scene")), explored_settings(m.get("scene"))
         if explored0 != explored1:
-            s0, s1 = _flat(explored0), _flat(explored1)
-            differ = sorted(k for k in set(s0) | set(s1) if s0.get(k) != s1.get(k))
-            shown = "; ".join(f"{k}: {s0.get(k, '(unset)')} and {s1.get(k, '(unset)')}" for k in differ[:3])
             raise AffordError(f"{first.source} and {art.source} were explored with different scene settings "
-                              f"({shown}{'; ...' if len(differ) > 3 else ''})")
+                              f"({settings_difference(explored0, explored1)})")
         if m0.get("seed") != m.get("seed"):
             raise AffordError(f"{first.source} and {art.source} were explored with different seeds "
                               f"({m0.get('seed')} and {m.get('seed')}), so they are not shards of one exploration")

@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from afford.artifacts import Artifact
-from afford.datasets import interactions_from_artifact, interactions_members
+from afford.datasets import explored_settings, interactions_from_artifact, interactions_members, settings_difference
 from afford.errors import AffordError
 
 __all__ = ["Journal", "journal_path"]
@@ -100,11 +100,14 @@ class Journal:
             raise AffordError(f"{self.dir} is not an exploration journal afford can read (no readable identity.json); "
                               "remove it to start afresh") from None
         mine = json.loads(_canonical(self.identity))
+        if isinstance(stored, dict) and isinstance(stored.get("scene"), dict):
+            # journals written before the identity left them out still hold the learner defaults
+            stored["scene"] = explored_settings(stored["scene"])
         if stored != mine:
             key = next(k for k in sorted(set(stored) | set(mine), key=lambda k: (k == "scene", k))
                        if stored.get(k) != mine.get(k))
-            why = ("its scene settings differ" if key == "scene"
-                   else f"its {key.replace('_', ' ')} is {stored.get(key)}, this run's {mine.get(key)}")
+            why = (f"its scene settings differ: {settings_difference(stored.get(key) or {}, mine.get(key) or {})}"
+                   if key == "scene" else f"its {key.replace('_', ' ')} is {stored.get(key)}, this run's {mine.get(key)}")
             raise AffordError(f"{self.dir} is the journal of another exploration ({why}): give that run's "
                               "options to resume it, or remove the folder to start afresh")
         meta = self.dir / "meta.json"

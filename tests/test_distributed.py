@@ -5,6 +5,7 @@ binds 127.0.0.1 only and is torn down."""
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import signal
 import subprocess
@@ -119,11 +120,35 @@ def test_a_journal_of_another_run_is_refused_and_kept(tmp_path):
     runner = CliRunner()
     for args, why in ((["--seed", "6", "--episodes", "60"], "its seed is 5, this run's 6"),
                       (["--seed", "5", "--episodes", "80"], "its episodes is 60, this run's 80"),
-                      (["--seed", "5", "--episodes", "60", "--size-max", "0.2"], "its scene settings differ")):
+                      (["--seed", "5", "--episodes", "60", "--size-max", "0.2"],
+                       "its scene settings differ: size_range: [0.08, 0.4] and [0.08, 0.2]")):
         r = runner.invoke(app, ["explore", *args, "-o", str(tmp_path / "j.afford"), "--resume"])
         assert r.exit_code == 1 and why in r.output and r.output.count("\n") == 1, r.output
     assert (journal / "episodes.log").read_bytes() == before
     assert not (tmp_path / "j.afford").exists()
+
+
+def test_a_journal_that_names_the_learner_defaults_still_resumes(one_shot, tmp_path):
+    """Journals written before the identity left the scene's learner defaults out (how to
+    cluster and train: not how rows are explored) resume; changing those defaults does not
+    change an exploration."""
+    import afford
+    from afford.errors import Interrupted
+
+    def stop_after_3(done, total):
+        if done >= 3:
+            raise KeyboardInterrupt
+
+    journal = tmp_path / "o.afford.partial"
+    with pytest.raises(Interrupted):
+        afford.explore("table", episodes=60, seed=5, journal=journal, progress=stop_after_3)
+    identity = json.loads((journal / "identity.json").read_text())
+    assert "learner" not in identity["scene"]
+    identity["scene"]["learner"] = {"search_rows": 3000}  # as an older afford wrote it
+    (journal / "identity.json").write_text(json.dumps(identity))
+    r = CliRunner().invoke(app, ["explore", *EPISODES, "-o", str(tmp_path / "o.afford"), "--resume"])
+    assert r.exit_code == 0, r.output
+    assert arrays(tmp_path / "o.afford") == arrays(one_shot)
 
 
 def test_shards_merge_into_the_one_shot_run_and_bad_shards_are_refused(one_shot, tmp_path):
