@@ -169,8 +169,14 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
         cost = wrapper_cost(data.schema, method, group_channels)
         if cost:
             warn(cost)
+    # ReliefF's cut is the only step that cross-validates on a sample: with --top, or a
+    # wrapper, the rows setting has nothing to act on and is neither used nor recorded.
+    cuts = method == "relieff" and top is None
+    if search_rows is not None and not cuts:
+        raise AffordError(f"--search-rows samples the rows ReliefF's ranking is cut on; "
+                          f"{'--top ' + str(top) if top is not None else '--method ' + method} makes no such cut")
     start = time.perf_counter()
-    rows = search_rows_setting(art, data, search_rows)
+    rows = search_rows_setting(art, data, search_rows) if cuts else None
     relevance = rank_features(data, labels, method=method, top=top, seed=seed, group_channels=group_channels,
                               kernel=kernel_name, score=score_name, search_rows=rows,
                               progress=_per_behaviour(progress, data))

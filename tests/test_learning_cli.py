@@ -344,6 +344,20 @@ def test_train_can_choose_c_and_gamma_on_a_sample_and_records_it(pipeline, tmp_p
     assert all(r["search_rows"] <= 60 + 2 * len(r["class_counts"]) for r in cv.values())
 
 
+def test_select_features_records_search_rows_only_where_it_samples_and_refuses_it_where_moot(pipeline, tmp_path):
+    e = str(pipeline / "effects.afford")
+    f = tmp_path / "f.afford"
+    ok(["select-features", e, "-o", str(f), "--search-rows", "60"])
+    assert all(r["search_rows"] == 60 for r in read_artifact(str(f)).manifest["relevance"].values())
+    top = tmp_path / "top.afford"
+    ok(["select-features", e, "-o", str(top), "--top", "5"])
+    assert all("search_rows" not in r for r in read_artifact(str(top)).manifest["relevance"].values())
+    for extra in (["--top", "5"], ["--method", "forward"]):
+        result = runner.invoke(app, ["select-features", e, "-o", str(tmp_path / "no.afford"), "--search-rows", "60", *extra])
+        assert result.exit_code == 1 and "makes no such cut" in result.output, result.output
+        assert not (tmp_path / "no.afford").exists()
+
+
 def test_search_rows_takes_any_whole_number_and_refuses_the_rest_in_one_sentence():
     from afford.errors import AffordError
     from afford.learning import search_rows_setting
