@@ -157,6 +157,12 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
     from afford.learn.affordances import rank_features
     from afford.learning import features_members, learner_settings, search_rows_setting, selection_score
 
+    # ReliefF's cut is the only step that cross-validates on a sample: with --top, or a
+    # wrapper, the rows setting has nothing to act on and is neither used nor recorded.
+    cuts = method == "relieff" and top is None
+    if search_rows is not None and not cuts:
+        raise AffordError(f"--search-rows samples the rows ReliefF's ranking is cut on; "
+                          f"{'--top ' + str(top) if top is not None else '--method ' + method} makes no such cut")
     check_output(output, [path])
     art, data = read_rows(path, ("interactions", "effects", "features"))
     labels, _ = read_effects(art, data)
@@ -169,12 +175,6 @@ def select_features(path: str, output: str, *, method: str = "relieff", top: int
         cost = wrapper_cost(data.schema, method, group_channels)
         if cost:
             warn(cost)
-    # ReliefF's cut is the only step that cross-validates on a sample: with --top, or a
-    # wrapper, the rows setting has nothing to act on and is neither used nor recorded.
-    cuts = method == "relieff" and top is None
-    if search_rows is not None and not cuts:
-        raise AffordError(f"--search-rows samples the rows ReliefF's ranking is cut on; "
-                          f"{'--top ' + str(top) if top is not None else '--method ' + method} makes no such cut")
     start = time.perf_counter()
     rows = search_rows_setting(art, data, search_rows) if cuts else None
     relevance = rank_features(data, labels, method=method, top=top, seed=seed, group_channels=group_channels,

@@ -32,7 +32,7 @@ def select_features(
     group_channels: Annotated[bool, typer.Option("--group-channels", help="Wrappers move each 18-bin histogram as one unit.")] = False,
     kernel: KernelOption = None,
     score: Annotated[Optional[Score], typer.Option(help="What ReliefF's ranking cut scores: the SVM's cross-validated accuracy, or its calibrated probabilities' log loss (a feature that makes a rare effect likelier without making it the likeliest counts). Default: the scene's own (grasp: log-loss), else accuracy.")] = None,
-    search_rows: Annotated[Optional[int], typer.Option("--search-rows", min=10, help="Cut ReliefF's ranking by cross-validating on a stratified sample of at most this many rows per behaviour (the ranking reads every row); by default the scene's (grasp: 3000), else every row.")] = None,
+    search_rows: Annotated[Optional[int], typer.Option("--search-rows", min=10, help="Cut ReliefF's ranking by cross-validating on a stratified sample of at most this many rows per behaviour (the ranking reads every row); by default the scene's (grasp: 3000), else every row. Not with --top or a wrapper, which make no cut.")] = None,
     seed: Seed = 0,
     json: Json = False,
 ) -> None:
