@@ -207,7 +207,7 @@ def learner_settings(art: Artifact | None, data: Interactions | dict, kernel: st
     and 3 folds."""
     learner = _scene_learner(data if isinstance(data, dict) else data.scene)
     kernel = kernel if kernel is not None else str(learner.get("kernel", "rbf"))
-    if kernel not in ("rbf", "linear"):
+    if kernel not in ("rbf", "linear", "forest"):
         raise AffordError(f"{art.source if art else 'the data'} asks for an unknown kernel {kernel!r}; give --kernel")
     try:
         folds = folds if folds is not None else int(learner.get("folds", 3))

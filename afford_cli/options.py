@@ -27,10 +27,13 @@ Alternatives = Annotated[int, typer.Option(
 class Kernel(str, Enum):
     rbf = "rbf"
     linear = "linear"
+    forest = "forest"
 
 
 KernelOption = Annotated[Optional[Kernel], typer.Option(
-    "--kernel", help="SVM kernel; by default the scene's (linear for the traverse scenes, as in thesis chapter 5; RBF at the table).")]
+    "--kernel", help="The learner: an SVM's kernel, or 'forest', a random forest (ours, not the thesis's; it needs no "
+                     "feature selection); by default the scene's (linear for the traverse scenes, as in thesis chapter 5; "
+                     "RBF at the table).")]
 
 
 class EffectModel(str, Enum):

@@ -293,8 +293,12 @@ def _temperature_log_loss(D, y, fit_rows, eval_rows):
 
 def _margins(model, X, n_classes):
     """Per-category decision values of a fitted classifier, one column per category of all
-    ``n_classes`` (a category its training fold lacked gets a margin far below the rest)."""
-    D = np.asarray(model.decision_function(X), dtype=float)
+    ``n_classes`` (a category its training fold lacked gets a margin far below the rest).
+    A classifier without margins (a forest) gives its log-probabilities."""
+    if hasattr(model, "decision_function"):
+        D = np.asarray(model.decision_function(X), dtype=float)
+    else:
+        D = np.log(np.asarray(model.predict_proba(X), dtype=float) + 1e-6)
     if D.ndim == 1:  # binary: one margin, for the second class
         D = np.column_stack([-D / 2, D / 2])
     out = np.full((D.shape[0], n_classes), -1e3 + D.min() if D.size else -1e3)

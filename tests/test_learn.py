@@ -282,6 +282,21 @@ def test_a_log_loss_cut_keeps_a_feature_that_makes_a_rare_effect_likelier(seed):
         ranking_prefix(X, y, ranking, scoring="auc")
 
 
+def test_a_forest_cuts_the_ranking_by_its_votes_log_loss():
+    """A forest has no margins: the log loss cut reads its votes, and still finds the rare
+    effect's feature that a noise feature was ranked above."""
+    from afford.learn.affordances import prefix_estimator
+    from afford.learn.relevance import ranking_prefix
+
+    rng = np.random.default_rng(0)
+    X = rng.random((1500, 5))
+    y = (rng.random(1500) < np.where(X[:, 0] > 0.85, 0.4, 0.0)).astype(int)
+    k, path = ranking_prefix(X, y, np.array([1, 0, 2, 3, 4]), estimator=prefix_estimator("forest"), random_state=0,
+                             scoring="log_loss")
+    by_k = {p["k"]: p["log_loss"] for p in path}
+    assert k >= 2 and by_k[2] < by_k[1] - 0.02
+
+
 def test_forward_selection_finds_planted_features():
     X, y = relevance_data()
     selected, ranking, path = forward_selection(X, y, random_state=0)
@@ -426,7 +441,8 @@ def test_predictor_round_trips_through_skops():
     X = rng.normal(size=(200, 3))
     y = np.digitize(X[:, 0], [-0.5, 0.5])
     reported = set()
-    for calibration, kernel in (("sigmoid", "rbf"), ("isotonic", "rbf"), ("temperature", "linear")):
+    for calibration, kernel in (("sigmoid", "rbf"), ("isotonic", "rbf"), ("temperature", "linear"),
+                                ("temperature", "forest")):
         model = AffordancePredictor(kernel=kernel, calibration=calibration, random_state=0).fit(X, y)
         data = sio.dumps(model)
         untrusted = sio.get_untrusted_types(data=data)
@@ -434,19 +450,45 @@ def test_predictor_round_trips_through_skops():
         loaded = sio.loads(data, trusted=TRUSTED_TYPES)
         assert np.array_equal(loaded.predict_proba(X), model.predict_proba(X))
         assert loaded.cv_report_ == model.cv_report_
-        if calibration == "sigmoid":  # the default needs all but the temperature type
-            assert set(TRUSTED_TYPES) - set(untrusted) == {"sklearn.calibration._TemperatureScaling"}
+        if calibration == "sigmoid":  # the SVM needs all but the temperature and the forest's tree types
+            assert set(TRUSTED_TYPES) - set(untrusted) == {"sklearn.calibration._TemperatureScaling",
+                                                           "afford.learn.predictors._Forest", "sklearn.tree._tree.Tree"}
     assert reported == set(TRUSTED_TYPES)
     # every class a predictor is built of is in PARTS, the model file's allow-list: binary too
     from afford.artifacts import _check_parts
     from afford.learn.predictors import PARTS
 
     for calibration, kernel, yy in (("sigmoid", "rbf", y), ("isotonic", "linear", y), ("temperature", "rbf", y > 0),
-                                    ("temperature", "linear", y > 0), ("sigmoid", "linear", y > 0)):
+                                    ("temperature", "linear", y > 0), ("sigmoid", "linear", y > 0),
+                                    ("temperature", "forest", y), ("temperature", "forest", y > 0)):
         blob = sio.dumps(AffordancePredictor(kernel=kernel, calibration=calibration, random_state=0).fit(X, yy))
         _check_parts(blob, "fitted", PARTS, "AffordancePredictor")  # raises on a class outside
     with pytest.raises(Exception, match="[Uu]ntrusted"):
         sio.loads(data, trusted=[])
+
+
+def test_forest_predictor_learns_what_a_linear_machine_cannot_and_repeats_itself():
+    # a planted exclusive-or of two signs: no line separates it, trees do
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(400, 4))
+    y = ((X[:, 0] > 0) ^ (X[:, 1] > 0)).astype(int)
+    T = rng.normal(size=(1000, 4))
+    truth = ((T[:, 0] > 0) ^ (T[:, 1] > 0)).astype(int)
+    forest = AffordancePredictor(kernel="forest", random_state=5).fit(X, y)
+    linear = AffordancePredictor(kernel="linear", random_state=5).fit(X, y)
+    assert np.mean(forest.predict(T) == truth) > 0.9
+    assert np.mean(linear.predict(T) == truth) < 0.65
+    p = forest.predict_proba(T)
+    assert np.allclose(p.sum(axis=1), 1.0) and "min_samples_leaf" in forest.cv_report_["best_params"]
+    # sure where the sign pattern is clear, unsure on the dividing lines
+    clear = (np.abs(T[:, 0]) > 1) & (np.abs(T[:, 1]) > 1)
+    assert p[clear].max(axis=1).mean() > p[~clear].max(axis=1).mean()
+    again = AffordancePredictor(kernel="forest", random_state=5, n_jobs=1).fit(X, y)
+    assert np.array_equal(again.predict_proba(T), p)  # the same trees whatever the threads
+    from afford.artifacts import dump_estimator
+
+    twin = AffordancePredictor(kernel="forest", random_state=5).fit(X, y)
+    assert dump_estimator(twin) == dump_estimator(forest)  # and the same bytes in a model file
 
 
 def test_predictor_is_deterministic():

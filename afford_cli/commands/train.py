@@ -31,14 +31,18 @@ def train(
                      search_rows=search_rows, progress=update)
 
     def render(console):
-        table = Table(title=f"trained predictors ({result['kernel']} SVM)")
-        for col in ("behaviour", "categories", "features", "C", "gamma", "cross-validated accuracy"):
+        learner = "random forest" if result["kernel"] == "forest" else f"{result['kernel']} SVM"
+        table = Table(title=f"trained predictors ({learner})")
+        forest = result["kernel"] == "forest"
+        for col in ("behaviour", "categories", "features", *(("smallest leaf",) if forest else ("C", "gamma")),
+                    "cross-validated accuracy"):
             table.add_column(col, no_wrap=True)
         for name, b in result["behaviors"].items():
             p = b["best_params"]
             # a behaviour with one effect has no machine: it is certain of that effect
-            table.add_row(name, str(b["n_categories"]), str(b["n_features"]), f"{p['C']}" if "C" in p else "-",
-                          f"{p.get('gamma', '-'):.3g}" if "gamma" in p else "-", f"{100 * b['cv_accuracy']:.1f}%")
+            grid = ([f"{p['min_samples_leaf']:g}" if "min_samples_leaf" in p else "-"] if forest else
+                    [f"{p['C']}" if "C" in p else "-", f"{p.get('gamma', '-'):.3g}" if "gamma" in p else "-"])
+            table.add_row(name, str(b["n_categories"]), str(b["n_features"]), *grid, f"{100 * b['cv_accuracy']:.1f}%")
         console.print(table)
         console.print(f"-> {output} ({result['seconds']:.1f} s)")
 

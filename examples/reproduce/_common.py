@@ -48,16 +48,29 @@ def quartiles(values) -> dict:
     return {"median": round(float(med), 4), "q1": round(float(q1), 4), "q3": round(float(q3), 4), "n": int(v.size)}
 
 
+def learner_option(ap) -> None:
+    """``--kernel``: the learner ``train_model`` fits (default: the scene's)."""
+    ap.add_argument("--kernel", choices=("linear", "rbf", "forest"), default=None,
+                    help="the learner (default: the scene's linear SVM); forest: a random forest on every feature")
+
+
 def train_model(scene: str, args, directory: Path) -> str:
     """Explore ``scene`` and learn as ``afford select-features | afford train`` does; the
     model's path in ``directory``. ``args.episodes`` sizes the exploration if given; else 100
-    environments in quick mode and 5000 interactions in full mode (the README's models)."""
+    environments in quick mode and 5000 interactions in full mode (the README's models).
+    ``args.kernel``, where a script has it, is the learner (None: the scene's); a forest
+    trains on every feature, with no selection."""
     import afford
 
     size = {"episodes": args.episodes} if args.episodes else (
         {"episodes": 100} if args.quick else {"interactions": 5000})
     data = afford.explore(scene, seed=args.seed, workers=args.workers, **size)
     afford.save(data, str(directory / "train.afford"), seed=args.seed)
-    afford.select_features(str(directory / "train.afford"), str(directory / "features.afford"), seed=args.seed)
-    afford.train(str(directory / "features.afford"), str(directory / "model.afford"), seed=args.seed)
+    kernel = getattr(args, "kernel", None)
+    if kernel == "forest":  # a forest reads every feature: no selection
+        afford.train(str(directory / "train.afford"), str(directory / "model.afford"), seed=args.seed, kernel=kernel)
+        return str(directory / "model.afford")
+    afford.select_features(str(directory / "train.afford"), str(directory / "features.afford"), seed=args.seed,
+                           kernel=kernel)
+    afford.train(str(directory / "features.afford"), str(directory / "model.afford"), seed=args.seed, kernel=kernel)
     return str(directory / "model.afford")

@@ -1,7 +1,7 @@
 """Thesis Figure 5.5: the robot's sense of its body, a collision map predicted beside the real one.
 
     python examples/reproduce/fig_5_5_body.py [--quick] [--seed S] [--out DIR] [--workers W]
-        [--model M] [--episodes N] [--step CM]
+        [--model M] [--episodes N] [--step CM] [--kernel linear|rbf|forest]
 
 A 10 cm box, fixed where it is put, moves on a grid in front of the robot: (a) along the
 longitudinal and lateral axes, resting on the floor (x 0.30-1.20 m, y -0.45..0.45 m); (b)
@@ -11,6 +11,8 @@ floor). At every place the robot scans once and the model trained on ``traverse-
 least one half); beside it go-forward is run in PhysX there, judged by the robot's own
 odometry. Full mode: a model from 5000 interactions of seed S and a 3 cm grid, as the
 thesis's; ``--quick``: 100 environments and a 6 cm grid (minutes, for ``make reproduce``).
+The learner is the scene's (a linear SVM on ReliefF's cut, as chapter 5's) unless
+``--kernel`` names another: ``forest`` trains a random forest on all 3900 grid features.
 
 The boundaries (the thesis's lines: the critical points for pass-through-ability,
 go-forward-ability and drive-under-ability) are read from each map the same way: from the
@@ -36,7 +38,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser, train_model  # noqa: E402
+from _common import commit, learner_option, parser, train_model  # noqa: E402
 
 NAME = "fig_5_5_body"
 SCENE = "traverse-body"
@@ -125,6 +127,7 @@ def main() -> None:
     ap.add_argument("--episodes", type=int, default=None,
                     help="training environments (default: 5000 interactions; quick: 100 environments)")
     ap.add_argument("--step", type=float, default=None, help="grid step, cm (default 3; quick 6)")
+    learner_option(ap)
     args = ap.parse_args()
     step = (args.step if args.step is not None else (6.0 if args.quick else 3.0)) / 100
     if not 0.01 <= step <= 0.3:
@@ -158,6 +161,7 @@ def main() -> None:
     agreement = {m: round(float(np.mean([c["predicted"] == c["actual"] for c in grid if c["map"] == m])), 4)
                  for m in ("lateral", "vertical")}
     doc = {"name": NAME, "seed": args.seed, "commit": commit(), "quick": args.quick, "model": args.model,
+           "kernel": None if args.model else (args.kernel or "linear"),
            "box": BOX, "step": step, "rows": rows, "agreement": agreement,
            "within_one_step": sum(r["error"] is not None and abs(r["error"]) <= step + 1e-9 for r in rows),
            "thesis": "predicted boundaries on the real ones (figure 5.5; no numbers given)", "maps": grid}
@@ -175,7 +179,10 @@ def write(doc: dict, out: Path) -> None:
     what = {"left": "pass-through, left (y)", "right": "pass-through, right (y)",
             "depth": "go-forward, depth (x)", "height": "drive-under, height of the box's bottom (z)"}
     lines = ["# Figure 5.5: collision boundaries of go-forward (thesis 5.6.2.1)", "",
-             f"Scene `{doc['model'] or 'traverse-body'}`, seed {doc['seed']}, commit {doc['commit']}, "
+             f"Scene `{doc['model'] or 'traverse-body'}`"
+             + (f" ({'a random forest' if doc.get('kernel') == 'forest' else (doc.get('kernel') or 'linear') + ' SVM'})"
+                if not doc["model"] else "")
+             + f", seed {doc['seed']}, commit {doc['commit']}, "
              f"{'quick' if doc['quick'] else 'full'} mode; a {100 * doc['box']:.0f} cm box on a {100 * step:g} cm grid.", "",
              "| boundary | predicted | actual (PhysX) | error |", "|---|---|---|---|"]
     lines += [f"| {what[r['boundary']]} | {cm(r['predicted'])} | {cm(r['actual'])} | {cm(r['error'])} |" for r in doc["rows"]]
