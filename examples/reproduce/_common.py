@@ -48,10 +48,20 @@ def quartiles(values) -> dict:
     return {"median": round(float(med), 4), "q1": round(float(q1), 4), "q3": round(float(q3), 4), "n": int(v.size)}
 
 
-def learner_option(ap) -> None:
-    """``--kernel``: the learner ``train_model`` fits (default: the scene's)."""
-    ap.add_argument("--kernel", choices=("linear", "rbf", "forest"), default=None,
-                    help="the learner (default: the scene's linear SVM); forest: a random forest on every feature")
+def learner_option(ap, default: str | None = None) -> None:
+    """``--kernel``: the learner ``train_model`` fits (``default``; None: the scene's)."""
+    what = default or "the scene's SVM"
+    ap.add_argument("--kernel", choices=("linear", "rbf", "forest"), default=default,
+                    help=f"the learner (default: {what}); forest: a random forest on every feature, with no "
+                         "feature selection")
+
+
+def learner_note(args) -> str:
+    """What a script's own model learned with, for its report: "" for the scene's learner."""
+    kernel = getattr(args, "kernel", None)
+    if getattr(args, "model", None) or kernel is None:
+        return ""
+    return ", a random forest" if kernel == "forest" else f", an {kernel} SVM" if kernel == "rbf" else f", a {kernel} SVM"
 
 
 def train_model(scene: str, args, directory: Path) -> str:

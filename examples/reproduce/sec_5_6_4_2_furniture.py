@@ -1,7 +1,7 @@
 """Thesis 5.6.4.2: tables and a chair, never met in training, judged by a robot that learned among simple objects.
 
     python examples/reproduce/sec_5_6_4_2_furniture.py [--quick] [--seed S] [--out DIR] [--workers W]
-        [--model M] [--episodes N] [--test-episodes M]
+        [--kernel linear|rbf|forest] [--model M] [--episodes N] [--test-episodes M]
 
 The robot learns on ``traverse`` (random boxes, cylinders and spheres, 5.6.1), as
 ``afford explore | select-features | train`` does, unless ``--model`` gives such a model.
@@ -36,7 +36,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser, train_model  # noqa: E402
+from _common import commit, learner_note, learner_option, parser, train_model  # noqa: E402
 
 NAME = "sec_5_6_4_2_furniture"
 TRAIN_SCENE = "traverse"
@@ -117,6 +117,7 @@ def _figure(doc: dict, path: Path) -> None:
 
 def main() -> None:
     ap = parser(__doc__)
+    learner_option(ap)
     ap.add_argument("--model", default=None, help=f"a model trained on {TRAIN_SCENE}: skip exploring and learning")
     ap.add_argument("--episodes", type=int, default=None, help="training environments (default: 5000 interactions; quick 100)")
     ap.add_argument("--test-episodes", type=int, default=None, help="test environments per piece (default 300; quick 30)")
@@ -136,7 +137,8 @@ def main() -> None:
     except (AffordError, DataError) as exc:
         sys.exit(f"error: {exc}")
     trained = (f"model {args.model}" if args.model else
-               f"{args.episodes} environments" if args.episodes else "100 environments" if args.quick else "5000 interactions")
+               f"{args.episodes} environments" if args.episodes else "100 environments" if args.quick else "5000 interactions"
+               ) + learner_note(args)
     doc = {"name": NAME, "seed": args.seed, "commit": commit(), "quick": args.quick, "trained_on": trained, "rows": rows}
     write(doc, Path(args.out))
     print((Path(args.out) / f"{NAME}.md").read_text())
