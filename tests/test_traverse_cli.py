@@ -157,12 +157,11 @@ def test_kernel_and_folds_override_the_scenes_learner(learned, tmp_path):
 def test_a_forest_learns_from_every_grid_feature(learned, tmp_path):
     # no select-features: a forest reads all 3900 features
     model = str(tmp_path / "m.afford")
-    out = ok(["train", str(learned / "train.afford"), "--kernel", "forest", "--folds", "3", "--seed", "2", "-o", model])
-    assert "random forest" in out.stdout and "smallest leaf" in out.stdout
+    out = ok(["train", str(learned / "train.afford"), "--kernel", "forest", "--folds", "2", "--seed", "2", "-o", model])
+    assert "random forest" in out.stdout and "smallest leaf" in out.stdout and "3900" in out.stdout
     info = json.loads(ok(["inspect", model, "--json"]).stdout)
     assert info["training"]["kernel"] == "forest"
-    assert all("min_samples_leaf" in p["cv"]["best_params"] and p["n_features"] == 3900
-               for p in info["predictors"].values())
+    assert all("min_samples_leaf" in p["cv"]["best_params"] for p in info["predictors"].values())
     check = json.loads(ok(["predict", model, "--scene", "traverse", "--seed", "4", "--check", "--json"]).stdout)
     assert check["checked"] == 7
     for p in check["objects"][0]["behaviors"].values():
