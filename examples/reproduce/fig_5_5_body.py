@@ -38,7 +38,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, learner_option, parser, train_model  # noqa: E402
+from _common import commit, learner_note, learner_option, parser, train_model  # noqa: E402
 
 NAME = "fig_5_5_body"
 SCENE = "traverse-body"
@@ -161,7 +161,7 @@ def main() -> None:
     agreement = {m: round(float(np.mean([c["predicted"] == c["actual"] for c in grid if c["map"] == m])), 4)
                  for m in ("lateral", "vertical")}
     doc = {"name": NAME, "seed": args.seed, "commit": commit(), "quick": args.quick, "model": args.model,
-           "kernel": None if args.model else (args.kernel or "linear"),
+           "kernel": None if args.model else (args.kernel or "linear"), "learner": learner_note(args),
            "box": BOX, "step": step, "rows": rows, "agreement": agreement,
            "within_one_step": sum(r["error"] is not None and abs(r["error"]) <= step + 1e-9 for r in rows),
            "thesis": "predicted boundaries on the real ones (figure 5.5; no numbers given)", "maps": grid}
@@ -179,10 +179,7 @@ def write(doc: dict, out: Path) -> None:
     what = {"left": "pass-through, left (y)", "right": "pass-through, right (y)",
             "depth": "go-forward, depth (x)", "height": "drive-under, height of the box's bottom (z)"}
     lines = ["# Figure 5.5: collision boundaries of go-forward (thesis 5.6.2.1)", "",
-             f"Scene `{doc['model'] or 'traverse-body'}`"
-             + (f" ({'a random forest' if doc.get('kernel') == 'forest' else (doc.get('kernel') or 'linear') + ' SVM'})"
-                if not doc["model"] else "")
-             + f", seed {doc['seed']}, commit {doc['commit']}, "
+             f"Scene `{doc['model'] or 'traverse-body'}`{doc['learner']}, seed {doc['seed']}, commit {doc['commit']}, "
              f"{'quick' if doc['quick'] else 'full'} mode; a {100 * doc['box']:.0f} cm box on a {100 * step:g} cm grid.", "",
              "| boundary | predicted | actual (PhysX) | error |", "|---|---|---|---|"]
     lines += [f"| {what[r['boundary']]} | {cm(r['predicted'])} | {cm(r['actual'])} | {cm(r['error'])} |" for r in doc["rows"]]
