@@ -1,5 +1,6 @@
 """Learning speed: cluster, each feature selection and train on a table exploration, or
-ReliefF and train on a traverse exploration (3900 features, given results), with peak memory.
+ReliefF and train on a traverse exploration (3900 features, given results), with peak memory,
+and there a random forest on every feature: fit, model size, save, load, one row's prediction.
 
     python benchmarks/learn.py [--scene table|traverse|...] [--interactions 5000] [--data PATH] [--out FILE]
 
@@ -101,6 +102,7 @@ def given_labels(args) -> None:
     chosen = {k: v.selected_ for k, v in relevance.items()}
     after_relieff = peak_mb()
     _, train_s = timed(train_predictors, data, labels, chosen, kernel=kernel, folds=folds, seed=0)
+    forest = forest_figures(data, labels, chosen)
     result = {
         "benchmark": "learn",
         "scene": args.scene,
@@ -112,8 +114,30 @@ def given_labels(args) -> None:
         "seconds": {"explore_2_workers": explore_s, "select_relieff": relieff_s, "train": train_s,
                     "pipeline_relieff_train": round(relieff_s + train_s, 2)},
         "peak_memory_mb": {"after_loading": before, "after_relieff": after_relieff, "after_train": peak_mb()},
+        "forest": forest,
     }
     emit(result, args.out)
+
+
+def forest_figures(data, labels, chosen) -> dict:
+    """``train --kernel forest`` on every feature: the fit, one model file's bytes, saving and
+    loading them (skops, the trees packed), and one row's prediction (navigation's call)."""
+    import numpy as np
+    import skops.io as sio
+
+    from afford.artifacts import dump_estimator
+    from afford.learn.predictors import TRUSTED_TYPES
+
+    everything = {k: np.arange(len(data.schema)) for k in chosen}
+    models, fit_s = timed(train_predictors, data, labels, everything, kernel="forest", seed=0)
+    blobs, dump_s = timed(lambda: [dump_estimator(m) for m in models.values()])
+    _, load_s = timed(lambda: [sio.loads(b, trusted=TRUSTED_TYPES) for b in blobs])
+    model = next(iter(models.values()))
+    row = data.before_rows(np.arange(1))[:, :model.n_features_in_]  # the traverse moves take no parameters
+    model.predict_proba(row)
+    _, one_row_s = timed(lambda: [model.predict_proba(row) for _ in range(100)])
+    return {"train_s": fit_s, "model_mb": round(sum(map(len, blobs)) / 2**20, 1), "save_s": dump_s, "load_s": load_s,
+            "predict_one_row_ms": round(one_row_s * 10, 2)}
 
 
 if __name__ == "__main__":

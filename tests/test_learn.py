@@ -450,9 +450,9 @@ def test_predictor_round_trips_through_skops():
         loaded = sio.loads(data, trusted=TRUSTED_TYPES)
         assert np.array_equal(loaded.predict_proba(X), model.predict_proba(X))
         assert loaded.cv_report_ == model.cv_report_
-        if calibration == "sigmoid":  # the SVM needs all but the temperature and the forest's tree types
+        if calibration == "sigmoid":  # the SVM needs all but the temperature and the forest
             assert set(TRUSTED_TYPES) - set(untrusted) == {"sklearn.calibration._TemperatureScaling",
-                                                           "afford.learn.predictors._Forest", "sklearn.tree._tree.Tree"}
+                                                           "afford.learn.predictors._Forest"}
     assert reported == set(TRUSTED_TYPES)
     # every class a predictor is built of is in PARTS, the model file's allow-list: binary too
     from afford.artifacts import _check_parts
@@ -605,3 +605,57 @@ def test_a_wrapper_that_would_run_for_hours_is_announced_and_a_small_one_is_not(
     assert wrapper_cost(grid, "relieff") is None
     table = FeatureSchema(tuple(f"f{i}" for i in range(43)), ("position",) * 43)
     assert wrapper_cost(table, "backward") is None and wrapper_cost(table, "forward") is None
+
+
+def test_forest_votes_as_scikit_learn_and_is_saved_packed():
+    """_Forest adds its trees' votes without a joblib task per tree, to the same bits as
+    scikit-learn's forest on one thread; saved, its trees are packed into arrays (no tree
+    object in the file) and rebuilt to the same votes and the same canonical bytes."""
+    from sklearn.ensemble import RandomForestClassifier
+
+    from afford.artifacts import dump_estimator
+    from afford.learn.predictors import _Forest
+
+    rng = np.random.default_rng(8)
+    X = rng.normal(size=(300, 6))
+    y = np.digitize(X[:, 0] * X[:, 1], [-0.3, 0.3])
+    T = rng.normal(size=(200, 6))
+    ours = _Forest(50, min_samples_leaf=2, random_state=4, n_jobs=-1).fit(X, y)
+    theirs = RandomForestClassifier(50, min_samples_leaf=2, random_state=4, n_jobs=1).fit(X, y)
+    assert np.array_equal(ours.predict_proba(T), theirs.predict_proba(T))
+    data = sio.dumps(ours)
+    assert sio.get_untrusted_types(data=data) == ["afford.learn.predictors._Forest"]  # no tree in the file
+    assert len(ours.estimators_) == 50  # saving left the forest whole
+    loaded = sio.loads(data, trusted=TRUSTED_TYPES)
+    assert len(loaded.estimators_) == 50 and np.array_equal(loaded.predict_proba(T), theirs.predict_proba(T))
+    assert dump_estimator(loaded) == dump_estimator(ours)
+    # an edited file whose node points outside its tree is refused, not followed
+    from afford.learn.predictors import _pack_trees, _unpack_trees
+
+    packed = _pack_trees(ours.estimators_)
+    assert len(_unpack_trees(packed)) == 50
+    for field, value in (("left_child", 10**6), ("right_child", 0), ("feature", 6)):  # outside; a loop; no feature
+        edited = dict(packed, nodes=packed["nodes"].copy())
+        edited["nodes"][field][0] = value
+        with pytest.raises(ValueError, match="outside"):
+            _unpack_trees(edited)
+
+
+def test_forest_probabilities_are_calibrated_out_of_bag():
+    # P(y = 1 | x) = sigmoid(2 x0) planted: out-of-bag votes calibrate the forest to within
+    # 4 points per probability decile on fresh rows
+    rng = np.random.default_rng(11)
+
+    def draw(n):
+        X = rng.normal(size=(n, 5))
+        p = 1 / (1 + np.exp(-2.0 * X[:, 0]))
+        return X, (rng.random(n) < p).astype(int), p
+
+    X, y, _ = draw(1500)
+    T, t, truth = draw(4000)
+    model = AffordancePredictor(kernel="forest", random_state=0).fit(X, y)
+    assert model.cv_report_["validation"] == "out-of-bag" and 0.7 < model.cv_report_["cv_accuracy"] < 0.8
+    p = model.predict_proba(T)[:, 1]
+    decile = np.minimum((p * 10).astype(int), 9)
+    ece = sum(abs(p[decile == k].mean() - t[decile == k].mean()) * np.mean(decile == k) for k in np.unique(decile))
+    assert ece < 0.04 and np.abs(p - truth).mean() < 0.08

@@ -107,13 +107,12 @@ def render(console, info: dict) -> None:
         render_result_rates(console, info["result_rates"])
     if info.get("predictors"):
         pt = Table(title="predictors of the given results")
-        for col in ("behaviour", "training rows by result", "features", "C", "cross-validated accuracy"):
+        for col in ("behaviour", "training rows by result", "features", "setting", "held-out accuracy"):
             pt.add_column(col)
         for name, p in info["predictors"].items():
             cv = p["cv"]
             pt.add_row(name, ", ".join(f"{k} {v}" for k, v in p["results"].items()), str(info.get("n_selected", {}).get(name, "?")),
-                       str(cv.get("best_params", {}).get("C", "?")),
-                       f"{100 * cv['cv_accuracy']:.1f} % ({cv.get('n_splits', '?')} folds)" if "cv_accuracy" in cv else "?")
+                       _setting(cv), _held_out(cv))
         console.print(pt)
     if info.get("n_selected"):
         n = len(info["features"])
@@ -140,9 +139,7 @@ def render(console, info: dict) -> None:
                 if cv.get("constant"):
                     extra.append("one effect only: predicted with certainty")
                 else:
-                    extra.append(f"cross-validated accuracy {100 * cv['cv_accuracy']:.1f}% "
-                                 f"(C={_short(cv['best_params'].get('C'))}, "
-                                 f"gamma={_short(cv['best_params'].get('gamma', '-'))})")
+                    extra.append(f"accuracy {_held_out(cv)}, {_setting(cv)}")
             if report.get("member_effects"):
                 me = report["member_effects"]
                 k = me.get("k") if isinstance(me.get("k"), dict) else {}
@@ -163,6 +160,22 @@ def render(console, info: dict) -> None:
 def _short(value) -> str:
     """A hyperparameter as a reader wants it: four significant digits (``0.00833``, ``1000``)."""
     return f"{value:.4g}" if isinstance(value, float) else str(value)
+
+
+def _setting(cv: dict) -> str:
+    """A predictor's chosen setting: ``C=10, gamma=0.0833`` for an SVM, ``smallest leaf 3`` for a forest."""
+    p = cv.get("best_params", {})
+    if "min_samples_leaf" in p:
+        return f"smallest leaf {p['min_samples_leaf']:g}"
+    return f"C={_short(p.get('C', '?'))}, gamma={_short(p.get('gamma', '-'))}"
+
+
+def _held_out(cv: dict) -> str:
+    """The chosen setting's held-out accuracy and how it was held out (folds, or a forest's out-of-bag votes)."""
+    if "cv_accuracy" not in cv:
+        return "?"
+    how = "out-of-bag" if cv.get("validation") == "out-of-bag" else f"{cv.get('n_splits', '?')} folds"
+    return f"{100 * cv['cv_accuracy']:.1f} % ({how})"
 
 
 def _channels(features: list[dict]) -> list[tuple[str, list[str]]]:

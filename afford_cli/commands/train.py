@@ -35,7 +35,7 @@ def train(
         table = Table(title=f"trained predictors ({learner})")
         forest = result["kernel"] == "forest"
         for col in ("behaviour", "categories", "features", *(("smallest leaf",) if forest else ("C", "gamma")),
-                    "cross-validated accuracy"):
+                    "out-of-bag accuracy" if forest else "cross-validated accuracy"):
             table.add_column(col, no_wrap=True)
         for name, b in result["behaviors"].items():
             p = b["best_params"]
