@@ -45,7 +45,9 @@ bench: $(STAMP)
 # every thesis figure's script in its quick mode, then reproduce/index.md linking them
 reproduce: $(STAMP)
 	@mkdir -p reproduce
-	@for script in examples/reproduce/[!_]*.py; do echo "== $$script"; $(PY) $$script --quick --out reproduce || exit 1; done
+	@begin=$$(date +%s); for script in examples/reproduce/[!_]*.py; do echo "== $$script"; start=$$(date +%s); \
+	  $(PY) $$script --quick --out reproduce || exit 1; echo "== $$script took $$(( $$(date +%s) - start )) s"; done; \
+	  echo "== every quick mode took $$(( $$(date +%s) - begin )) s"
 	@{ echo "# Thesis figures reproduced (quick mode)"; echo; \
 	  for f in reproduce/*.md; do [ "$$f" = reproduce/index.md ] || echo "- [$$(head -n 1 $$f | sed 's/^# //')]($$(basename $$f))"; done; } > reproduce/index.md
 	@echo "-> reproduce/index.md"
