@@ -166,6 +166,39 @@ def test_check_layout_refuses_what_overlaps_the_robots_start():
     check_layout(TraverseLayout(items=(Item("box", (0.3, 0.3, 0.1), (0.1, 0.0), z=0.6, fixed=True),)))
 
 
+def test_rectangle_overlap_agrees_with_corners_and_edges_near_and_far():
+    """The overlap test (bounding circles first, then separating axes) against the
+    classic oracle: two rectangles meet iff a corner of one lies in the other or two edges cross."""
+    from afford.sim.traverse import _corners, _rects_overlap
+
+    def d(a, b, c):  # which side of a->b the point c lies on
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+    def inside(p, quad):  # quad counter-clockwise
+        return all(d(quad[k], quad[(k + 1) % 4], p) >= 0 for k in range(4))
+
+    def cross(p1, p2, q1, q2):
+        return d(p1, p2, q1) * d(p1, p2, q2) < 0 and d(q1, q2, p1) * d(q1, q2, p2) < 0
+
+    rng = np.random.default_rng(3)
+    met = 0
+    for _ in range(1500):
+        a = (tuple(rng.uniform(-1, 1, 2)), tuple(rng.uniform(0.02, 0.5, 2)), float(rng.uniform(0, 360)))
+        b = (tuple(rng.uniform(-1, 1, 2)), tuple(rng.uniform(0.02, 0.5, 2)), float(rng.uniform(0, 360)))
+        margin = float(rng.choice([0.0, 0.05]))
+        if rng.random() < 0.5:  # near: the bounding circles (with the margin) just touch or barely overlap
+            reach = sum(np.hypot(*(np.asarray(r[1]) + margin / 2)) for r in (a, b)) * rng.uniform(0.9, 1.01)
+            th = rng.uniform(0, 2 * np.pi)
+            b = ((a[0][0] + reach * np.cos(th), a[0][1] + reach * np.sin(th)), b[1], b[2])
+        qa = _corners(a[0], np.asarray(a[1]) + margin / 2, a[2])
+        qb = _corners(b[0], np.asarray(b[1]) + margin / 2, b[2])
+        truth = (any(inside(p, qb) for p in qa) or any(inside(p, qa) for p in qb)
+                 or any(cross(qa[i], qa[(i + 1) % 4], qb[j], qb[(j + 1) % 4]) for i in range(4) for j in range(4)))
+        assert _rects_overlap(a, b, margin) == truth, (a, b, margin)
+        met += truth
+    assert 150 < met < 1350  # both answers are exercised, near pairs and far ones
+
+
 @pytest.mark.parametrize("sampler", [sample_clutter, sample_body, sample_ramp, sample_gap])
 def test_sampled_layouts_are_valid_starts(sampler):
     rng = np.random.default_rng(5)
