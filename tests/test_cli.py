@@ -57,7 +57,8 @@ def test_inspect_reports_an_interactions_file(interactions):
 
 def test_inspect_human_report_shows_the_same_tables(interactions):
     path, _ = interactions
-    result = runner.invoke(app, ["inspect", str(path)])
+    # a wide terminal, whatever runs the tests (rich shortens column titles to fit 80 columns)
+    result = runner.invoke(app, ["inspect", str(path)], env={"COLUMNS": "160"})
     assert result.exit_code == 0
     for text in ("interactions", "features (43)", "visibility", "position", "shape", "push-left", "lying-cylinder", "no-change"):
         assert text in result.stdout

@@ -365,12 +365,11 @@ def test_a_grid_search_on_a_sample_keeps_every_category_and_still_calibrates_on_
     report = sampled.cv_report_
     assert 600 <= report["search_rows"] <= 610  # each category's share, rounded, and the rare one's two
     assert sampled.classes_.tolist() == [0, 1, 7]
-    full = AffordancePredictor(random_state=0).fit(x, y)
-    assert full.cv_report_["search_rows"] == 3000
+    assert AffordancePredictor(random_state=0).fit(x[:300], y[:300]).cv_report_["search_rows"] == 300  # unsampled: all
     xt, _, pt = noisy_logistic(2000, 1)
-    # the machine and its calibration saw every row: as close to the truth as the full search
-    err = [np.abs(m.predict_proba(xt)[:, 1] - pt).mean() for m in (sampled, full)]
-    assert err[0] < 0.07 and err[0] < err[1] + 0.02
+    # the machine and its calibration saw every row: near the planted truth (0.042-0.043 for
+    # four seeds; an unsampled search, 20 times slower, was 0.042 on 1200 rows)
+    assert np.abs(sampled.predict_proba(xt)[:, 1] - pt).mean() < 0.06
     # the same seed, the same sample: the same model
     again = AffordancePredictor(random_state=0, search_rows=600).fit(x, y)
     assert np.array_equal(again.predict_proba(xt), sampled.predict_proba(xt))

@@ -83,7 +83,7 @@ def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
     figures = {r["figure"] for r in doc["rows"]}
     assert figures >= {"7.5-left", "7.6.2", "7.5-right", "7.1", "7.6.5"}
-    assert [r["k"] for r in doc["rows"] if r["figure"] == "7.6.2"] == list(range(2, 11))
+    assert [r["k"] for r in doc["rows"] if r["figure"] == "7.6.2"] == [2, 4, 6, 8, 10]  # quick: every other k
     # lifting is learned from 150 episodes: far better than calling nothing liftable
     left = [r for r in doc["rows"] if r["figure"] == "7.5-left"]
     assert left[-1]["accuracy"] > 0.9
