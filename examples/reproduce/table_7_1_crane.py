@@ -27,8 +27,8 @@ What it runs (``crane-lift``; training episodes of seed S, test episodes of seed
   rate and mean plan length over the layouts.
 
 Full mode: 1000 training and 300 test episodes, 1000 placements, 20 case-study layouts.
-``--quick``: 300 and 100 episodes, 60 placements, 5 layouts, every other k in 7.6.2 (minutes, for
-``make reproduce``).
+``--quick``: 200 and 60 episodes, 60 placements, 5 layouts, every other k in 7.6.2 (4.3 minutes
+here, for ``make reproduce``).
 Writes ``DIR/table_7_1_crane.{md,json,png}``; the JSON's ``rows`` hold one row per cell,
 each with ``figure`` and, where the thesis gives one, ``thesis``.
 """
@@ -219,16 +219,16 @@ def case_rows(model, args) -> list[dict]:
 def main() -> None:
     ap = parser(__doc__)
     ap.add_argument("--placements", type=int, default=None, help="Table 7.1 placements (default 1000, quick 60)")
-    ap.add_argument("--train", type=int, default=None, help="training episodes (default 1000, quick 300)")
-    ap.add_argument("--test", type=int, default=None, help="test episodes (default 300, quick 100)")
+    ap.add_argument("--train", type=int, default=None, help="training episodes (default 1000, quick 200)")
+    ap.add_argument("--test", type=int, default=None, help="test episodes (default 300, quick 60)")
     ap.add_argument("--layouts", type=int, default=None, help="7.6.5 layouts (default 20, quick 5)")
     ap.add_argument("--effects", choices=["members", "prototype"], default="members",
                     help="the planner's effects: each object's own within its category (members) or the thesis's prototypes")
     args = ap.parse_args()
     import afford
 
-    n_train = args.train or (300 if args.quick else 1000)
-    n_test = args.test or (100 if args.quick else 300)
+    n_train = args.train or (200 if args.quick else 1000)
+    n_test = args.test or (60 if args.quick else 300)
     placements = args.placements or (60 if args.quick else 1000)
     args.layouts = args.layouts or (5 if args.quick else 20)
     with tempfile.TemporaryDirectory() as tmp:
