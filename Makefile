@@ -31,7 +31,7 @@ imports: $(STAMP)
 	@cp -r afford_cli $(VENV)/lint/afford && for p in sim features learn plan; do cp -r $$p $(VENV)/lint/afford/$$p; done
 	cd $(VENV)/lint && PYTHONPATH=. ../bin/lint-imports --config ../../pyproject.toml
 
-# the tests run on TEST_JOBS processes (pytest-xdist; 2 here: 19 minutes instead of 33)
+# the tests run on TEST_JOBS processes (pytest-xdist; 2 here: 21-22 minutes instead of 33-35)
 TEST_JOBS ?= 2
 test: imports
 	$(PY) -m pytest -q -n $(TEST_JOBS) --dist worksteal

@@ -299,8 +299,8 @@ def _rects_overlap(a, b, margin: float = 0.0) -> bool:
     m = margin / 2
     if math.hypot(ax - bx, ay - by) > math.hypot(ahx + m, ahy + m) + math.hypot(bhx + m, bhy + m):
         return False
-    ca = _corners(a[0], np.asarray(a[1]) + margin / 2, a[2])
-    cb = _corners(b[0], np.asarray(b[1]) + margin / 2, b[2])
+    ca = _corners(a[0], np.asarray(a[1]) + m, a[2])
+    cb = _corners(b[0], np.asarray(b[1]) + m, b[2])
     for corners in (ca, cb):
         for k in range(2):
             axis = corners[k + 1] - corners[k]
@@ -327,13 +327,13 @@ def check_layout(layout: TraverseLayout, robot: MobileRobotConfig = MobileRobotC
             if max(abs(e.position[0]), abs(e.position[1])) > _REACH:
                 raise DataError(f"{kind} {i} at {list(e.position)} lies off the floor, which reaches {_REACH:g} m "
                                 "about the robot; move it nearer")
-    for i, r in enumerate(layout.ramps):
-        for j in range(i + 1, len(layout.ramps)):
-            if _rects_overlap(r.footprint(), layout.ramps[j].footprint()):
-                raise DataError(f"ramps {i} and {j} overlap; move one of them")
-    # each item's footprint and heights once: the pairs below would rebuild them thousands of times
+    # each footprint and height once: the pairs below would rebuild them thousands of times
     feet, bottoms, tops = [it.footprint() for it in layout.items], [it.bottom for it in layout.items], [it.top for it in layout.items]
     ramps = [r.footprint() for r in layout.ramps]
+    for i in range(len(ramps)):
+        for j in range(i + 1, len(ramps)):
+            if _rects_overlap(ramps[i], ramps[j]):
+                raise DataError(f"ramps {i} and {j} overlap; move one of them")
     for i, it in enumerate(layout.items):
         if bottoms[i] < robot.height + margin and _rects_overlap(me, feet[i], margin):
             raise DataError(f"object {i} at {list(it.position)} overlaps the robot's start position; move it away")
