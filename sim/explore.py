@@ -19,6 +19,7 @@ rows are the same whatever the number of workers and whichever worker ran the ep
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import sys
@@ -376,10 +377,15 @@ def explore(
                 if total_rows >= interactions:
                     break
                 # Ask for about as many episodes as the rows still missing need, at the rate
-                # seen so far (about two rows an episode at the table, every behaviour once
-                # in a scan), so little is explored in vain.
-                first_guess = len(scene.behaviors) if scene.loop == "scan" else 2.0
-                rate = total_rows / (next_episode - first) if next_episode > first else first_guess
+                # seen so far, so little is explored in vain. A scan yields every behaviour
+                # once; a play episode yields as many rows as the object keeps moving (about
+                # 2 at the table, 6-7 with the hand), so the first batch only measures it.
+                if next_episode > first:
+                    rate = total_rows / (next_episode - first)
+                elif scene.loop == "scan":
+                    rate = float(len(scene.behaviors))
+                else:
+                    rate = math.inf
                 need = max(pool.workers * chunk, int((interactions - total_rows) / max(rate, 1.0)) + 1)
                 stop = next_episode + need
             todo = [e for e in range(next_episode, stop) if e not in finished]

@@ -727,12 +727,13 @@ class TraverseWorld:
         self._steps += 1
         if self._steps % self.config.watch_every:
             return
+        mine, touchable, touched = self._robot_links, self._touchable, self.touched
         for contact in self.scene.get_contacts():
             a, b = contact.bodies
-            for mine, other in ((a, b), (b, a)):
-                if mine in self._robot_links and other in self._touchable:
-                    if any(np.any(p.impulse) for p in contact.points):
-                        self.touched.add(self._touchable[other])
+            for other in ((b,) if a in mine else ()) + ((a,) if b in mine else ()):
+                key = touchable.get(other)
+                if key is not None and key not in touched and any(np.any(p.impulse) for p in contact.points):
+                    touched.add(key)
 
     def move(self, rotate_deg: float, drive_m: float = 0.70) -> Odometry:
         """Run one behaviour: rotate in place, then drive forward; the robot's own reading."""

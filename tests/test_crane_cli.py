@@ -15,12 +15,15 @@ BEHAVIOURS = "move-forward, move-left-30, move-right-30, move-left-60, move-righ
 def explored(tmp_path_factory):
     d = tmp_path_factory.mktemp("crane")
     ok(["explore", "--scene", "crane-lift", "--episodes", "150", "--seed", "1", "--workers", "2", "-o", str(d / "i.afford")])
+    # Every test gets the whole pipeline here, not from another test: xdist may run them apart.
+    ok(["cluster", str(d / "i.afford"), "-o", str(d / "e.afford")])
+    ok(["train", str(d / "e.afford"), "-o", str(d / "m.afford")])
     return d
 
 
 def test_the_scene_clusters_with_its_own_k_means_and_lift_splits_lifted_from_not(explored):
     d = explored
-    out = json.loads(ok(["cluster", str(d / "i.afford"), "-o", str(d / "e.afford"), "--json"]).stdout)
+    out = json.loads(ok(["cluster", str(d / "i.afford"), "-o", str(d / "e1.afford"), "--json"]).stdout)
     lift = out["behaviors"]["lift"]
     assert lift["n_categories"] == 2
     shares = [c["outcomes"].get("lifted", 0.0) for c in lift["categories"]]
@@ -42,7 +45,6 @@ def test_k_per_behaviour_and_bad_k_in_one_sentence(explored):
 
 def test_a_move_then_lift_plan_is_found_and_reaches_its_goal_in_simulation(explored):
     d = explored
-    ok(["train", str(d / "e.afford"), "-o", str(d / "m.afford")])
     # An upright cylinder beyond the crane, ahead and to the left: it must be approached first.
     (d / "far.toml").write_text('[[object]]\nshape = "cylinder"\nsize = [0.3, 0.3]\nposition = [0.9, 0.2]\n')
     out = json.loads(ok(["plan", str(d / "m.afford"), "--scene", "crane-lift", "--layout", str(d / "far.toml"),

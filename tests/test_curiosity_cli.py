@@ -104,7 +104,7 @@ def curious_table(tmp_path_factory):
                                  "--seed", "5")
 
 
-def test_at_the_table_it_is_curious_about_the_effect_categories_it_discovered(curious_table):
+def test_at_the_table_it_is_curious_about_the_effect_categories_it_discovered(curious_table, tmp_path):
     import afford
     from afford.sim.explore import scan_candidate
 
@@ -128,9 +128,10 @@ def test_at_the_table_it_is_curious_about_the_effect_categories_it_discovered(cu
     curve = out["curve"]
     assert {c["behavior"] for c in curve} == set(data.behavior_names)
     assert all(0 <= c["accuracy"] <= 1 and c["interactions"] >= 30 for c in curve)
-    # the artefact is ordinary interactions: the table's pipeline takes it
-    ok(["cluster", str(d / "cur.afford"), "-o", str(d / "e.afford")])
-    ok(["train", str(d / "e.afford"), "-o", str(d / "m.afford")])
+    # the artefact is ordinary interactions: the table's pipeline takes it (written to this
+    # test's own directory, not the module fixture's)
+    ok(["cluster", str(d / "cur.afford"), "-o", str(tmp_path / "e.afford")])
+    ok(["train", str(tmp_path / "e.afford"), "-o", str(tmp_path / "m.afford")])
 
 
 def test_a_table_test_set_without_first_steps_of_a_behaviour_is_refused(tmp_path):

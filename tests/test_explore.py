@@ -57,3 +57,17 @@ def test_progress_is_reported_up_to_the_total():
     explore(scene, episodes=5, seed=0, chunk=2, progress=lambda done, total: seen.append((done, total)))
     assert seen[-1] == (5, 5)
     assert [d for d, _ in seen] == sorted(d for d, _ in seen)
+
+
+def test_an_exploration_to_n_rows_runs_few_episodes_more_than_it_needs():
+    """The hand's episodes yield 6-7 rows each, not the table's 2: the first batch measures
+    the rate instead of guessing it (a fixed guess of 2 ran three times the episodes)."""
+    scene = get_scene("grasp")()
+    ran = []
+    data = explore(scene, interactions=30, seed=4, workers=1, chunk=2,
+                   on_done=lambda pairs: ran.extend(e for e, _ in pairs))
+    assert len(data) == 30
+    rows = np.bincount(data.episode)
+    needed = int(np.flatnonzero(np.cumsum(rows) >= 30)[0]) + 1  # episodes the 30 rows come from
+    assert rows[:needed].mean() > 3, "the premise: an episode of the hand yields several rows"
+    assert len(ran) <= needed + 2, (len(ran), needed)

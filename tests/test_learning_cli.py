@@ -101,15 +101,16 @@ def test_predict_from_a_layout(pipeline, tmp_path):
     assert result.exit_code == 1
 
 
-def test_a_pipe_runs_cluster_select_train(pipeline):
+def test_a_pipe_runs_cluster_select_train(pipeline, tmp_path):
     env = dict(os.environ)
     cmd = f"{sys.executable} -m afford"
+    # the model goes to this test's own directory, not into the session's shared pipeline
     proc = subprocess.run(
         f"{cmd} cluster {pipeline / 'train.afford'} -o - | {cmd} select-features - -o - --top 8 | "
-        f"{cmd} train - -o {pipeline / 'piped.afford'} --kernel linear",
+        f"{cmd} train - -o {tmp_path / 'piped.afford'} --kernel linear",
         shell=True, capture_output=True, env=env)
     assert proc.returncode == 0, proc.stderr.decode()[-2000:]
-    assert read_artifact(str(pipeline / "piped.afford"), "model").manifest["training"]["kernel"] == "linear"
+    assert read_artifact(str(tmp_path / "piped.afford"), "model").manifest["training"]["kernel"] == "linear"
 
 
 def _variant(pipeline, tmp_path, name, change):

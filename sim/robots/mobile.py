@@ -310,6 +310,7 @@ class MobileRobot:
                                                           stiffness=c.chain_stiffness, damping=c.chain_damping)
         self.start_z = float(floor)
         self._torque = math.nan
+        self._targets = (math.nan, math.nan)
         self._set_drive(0.0, 0.0, c.drive_torque)
 
     def _add_links(self, builder, base) -> None:
@@ -318,11 +319,11 @@ class MobileRobot:
     # -- senses ---------------------------------------------------------------------------
     def gyro(self) -> float:
         """The heading the gyro reads, radians (wrapped)."""
-        return _yaw_of(np.asarray(self.base.entity_pose.q, dtype=float))
+        return _yaw_of(self.base.entity_pose.q.tolist())  # float64 arithmetic, not float32
 
-    def encoders(self) -> np.ndarray:
+    def encoders(self) -> list[float]:
         """Wheel angles (radians) in :data:`WHEELS` order."""
-        return np.asarray(self.articulation.get_qpos(), dtype=float)[self._qindex]
+        return self.articulation.get_qpos()[self._qindex].tolist()
 
     # -- ground truth ---------------------------------------------------------------------
     def pose(self) -> Pose2D:
@@ -335,18 +336,26 @@ class MobileRobot:
 
     # -- motion ---------------------------------------------------------------------------
     def _set_drive(self, left: float, right: float, torque: float) -> None:
-        """Wheel speed targets (rad/s) per side, each wheel's torque limited to ``torque``."""
+        """Wheel speed targets (rad/s) per side, each wheel's torque limited to ``torque``.
+        Called every physics step: the joints are only told what changed."""
         if torque != self._torque:
             for j in self.wheels:
                 j.set_drive_properties(stiffness=0.0, damping=self.config.drive_damping, force_limit=torque)
             self._torque = torque
-        for j, name in zip(self.wheels, WHEELS):
-            j.set_drive_velocity_target(left if "left" in name else right)
+        if (left, right) != self._targets:
+            for j in self.wheels[0::2]:  # WHEELS alternates left, right
+                j.set_drive_velocity_target(left)
+            for j in self.wheels[1::2]:
+                j.set_drive_velocity_target(right)
+            self._targets = (left, right)
 
-    def _side_travel(self, q0: np.ndarray, q1: np.ndarray) -> tuple[float, float]:
+    def _side_travel(self, q0: list[float], q1: list[float]) -> tuple[float, float]:
         """Each side's wheel angle change (its chained wheels turn alike: their mean)."""
-        d = q1 - q0
-        return float(d[0::2].mean()), float(d[1::2].mean())
+        # Plain floats: this runs every physics step, where numpy's per-call cost dominates.
+        # Summed in numpy's order, so the result is the same to the bit.
+        l0, r0, l1, r1, l2, r2 = q0
+        m0, s0, m1, s1, m2, s2 = q1
+        return ((m0 - l0) + (m1 - l1) + (m2 - l2)) / 3, ((s0 - r0) + (s1 - r1) + (s2 - r2)) / 3
 
     def tilt(self) -> float:
         """The IMU's tilt: degrees between the body's up axis and the vertical."""
