@@ -45,11 +45,15 @@ bench: $(STAMP)
 	$(PY) benchmarks/curiosity.py
 
 # every thesis figure's script in its quick mode, then reproduce/index.md linking them
+# (the scripts share explorations and models of the same recipe through reproduce/.cache,
+# emptied before and after, so nothing from an older checkout is ever reused)
 reproduce: $(STAMP)
-	@mkdir -p reproduce
+	@rm -rf reproduce/.cache && mkdir -p reproduce
 	@begin=$$(date +%s); for script in examples/reproduce/[!_]*.py; do echo "== $$script"; start=$$(date +%s); \
-	  $(PY) $$script --quick --out reproduce || exit 1; echo "== $$script took $$(( $$(date +%s) - start )) s"; done; \
+	  $(PY) $$script --quick --out reproduce --cache reproduce/.cache || exit 1; \
+	  echo "== $$script took $$(( $$(date +%s) - start )) s"; done; \
 	  echo "== every quick mode took $$(( $$(date +%s) - begin )) s"
+	@rm -rf reproduce/.cache
 	@{ echo "# Thesis figures reproduced (quick mode)"; echo; \
 	  for f in reproduce/*.md; do [ "$$f" = reproduce/index.md ] || echo "- [$$(head -n 1 $$f | sed 's/^# //')]($$(basename $$f))"; done; } > reproduce/index.md
 	@echo "-> reproduce/index.md"

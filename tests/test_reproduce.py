@@ -8,14 +8,15 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 SCRIPTS = Path(__file__).parents[1] / "examples" / "reproduce"
 
 
 def test_traverse_accuracy_quick_mode_writes_md_png_json_with_the_thesis_beside_ours(tmp_path):
     script = SCRIPTS / "sec_5_6_traverse_accuracy.py"
-    subprocess.run([sys.executable, str(script), "--quick", "--scenes", "traverse-gaps", "--workers", "1",
-                    "--out", str(tmp_path)], check=True, capture_output=True)
+    subprocess.run([sys.executable, str(script), "--quick", "--scenes", "traverse-gaps", "--episodes", "60",
+                    "--workers", "1", "--out", str(tmp_path)], check=True, capture_output=True)
     doc = json.loads((tmp_path / "sec_5_6_traverse_accuracy.json").read_text())
     assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
     assert len(doc["rows"]) == 7 and {r["behavior"] for r in doc["rows"]} >= {"go-forward", "turn-left-60"}
@@ -27,6 +28,32 @@ def test_traverse_accuracy_quick_mode_writes_md_png_json_with_the_thesis_beside_
     assert (tmp_path / "sec_5_6_traverse_accuracy.png").read_bytes()[:4] == b"\x89PNG"
     bad = subprocess.run([sys.executable, str(script), "--scenes", "kitchen"], capture_output=True, text=True)
     assert bad.returncode == 1 and bad.stderr.strip().startswith("error: 'kitchen' is not a traverse scene")
+
+
+def test_a_cache_hands_a_later_script_the_same_exploration_without_exploring_again(tmp_path, monkeypatch):
+    """make reproduce's --cache: the scripts that learn from the same exploration share it."""
+    import argparse
+
+    import afford
+
+    monkeypatch.syspath_prepend(str(SCRIPTS))
+    import _common
+
+    args = argparse.Namespace(cache=str(tmp_path / "cache"), workers=1)
+    first = _common.explored("traverse-gaps", args, seed=3, episodes=2)
+
+    def refuse(*a, **k):
+        raise AssertionError("explored again")
+
+    monkeypatch.setattr(afford, "explore", refuse)
+    again = _common.explored("traverse-gaps", args, seed=3, episodes=2)
+    assert len(again) == len(first) == 14
+    assert again.before.tobytes() == first.before.tobytes() and np.array_equal(again.result, first.result)
+    for other in ({"seed": 4, "episodes": 2}, {"seed": 3, "episodes": 3}):  # another recipe is another exploration
+        with pytest.raises(AssertionError, match="explored again"):
+            _common.explored("traverse-gaps", args, **other)
+    with pytest.raises(AssertionError, match="explored again"):  # and without a cache nothing is kept
+        _common.explored("traverse-gaps", argparse.Namespace(cache=None, workers=1), seed=3, episodes=2)
 
 
 def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):

@@ -24,7 +24,42 @@ def parser(doc: str):
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--out", default="reproduce", help="where the .md, .png and .json go")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--cache", default=None, metavar="DIR",
+                    help="keep explorations and models here and reuse those of the same recipe (scene, seed, size, "
+                         "learner, afford version); make reproduce shares one among its scripts")
     return ap
+
+
+def _cached(args, recipe: dict, suffix: str) -> Path | None:
+    """Where ``recipe``'s artefact lives in ``args.cache`` (None: no cache). The name is the
+    hash of the recipe and afford's version, so a file is only ever reused for the same
+    exploration or learning; ``make reproduce`` empties the cache first, so edits to the code
+    between runs cannot leak in."""
+    import hashlib
+    import json
+
+    import afford
+
+    cache = getattr(args, "cache", None)
+    if not cache:
+        return None
+    key = json.dumps({**recipe, "afford": afford.__version__}, sort_keys=True)
+    Path(cache).mkdir(parents=True, exist_ok=True)
+    return Path(cache) / f"{hashlib.sha256(key.encode()).hexdigest()[:20]}.{suffix}.afford"
+
+
+def explored(scene: str, args, *, seed: int, **size):
+    """``afford.explore(scene, seed=seed, workers=args.workers, **size)`` (``size``:
+    ``episodes`` or ``interactions``), or the same exploration from ``args.cache``."""
+    import afford
+
+    path = _cached(args, {"scene": scene, "seed": seed, **size}, "interactions")
+    if path is not None and path.exists():
+        return afford.load(str(path))
+    data = afford.explore(scene, seed=seed, workers=args.workers, **size)
+    if path is not None:
+        afford.save(data, str(path), seed=seed)  # atomic: a killed run leaves no half file
+    return data
 
 
 def stream_parser(doc: str, situations: str):
@@ -68,19 +103,26 @@ def train_model(scene: str, args, directory: Path) -> str:
     """Explore ``scene`` and learn as ``afford select-features | afford train`` does; the
     model's path in ``directory``. ``args.episodes`` sizes the exploration if given; else 100
     environments in quick mode and 5000 interactions in full mode (the README's models).
+    With ``args.cache``, the exploration and the model are taken from there when a script
+    before made them from the same recipe, and left there for the next.
     ``args.kernel``, where a script has it, is the learner (None: the scene's); a forest
     trains on every feature, with no selection."""
     import afford
 
-    size = {"episodes": args.episodes} if args.episodes else (
+    episodes = getattr(args, "episodes", None)
+    size = {"episodes": episodes} if episodes else (
         {"episodes": 100} if args.quick else {"interactions": 5000})
-    data = afford.explore(scene, seed=args.seed, workers=args.workers, **size)
-    afford.save(data, str(directory / "train.afford"), seed=args.seed)
     kernel = getattr(args, "kernel", None)
+    cached = _cached(args, {"scene": scene, "seed": args.seed, **size, "kernel": kernel}, "model")
+    if cached is not None and cached.exists():
+        return str(cached)
+    data = explored(scene, args, seed=args.seed, **size)
+    afford.save(data, str(directory / "train.afford"), seed=args.seed)
+    model = str(cached or directory / "model.afford")
     if kernel == "forest":  # a forest reads every feature: no selection
-        afford.train(str(directory / "train.afford"), str(directory / "model.afford"), seed=args.seed, kernel=kernel)
-        return str(directory / "model.afford")
+        afford.train(str(directory / "train.afford"), model, seed=args.seed, kernel=kernel)
+        return model
     afford.select_features(str(directory / "train.afford"), str(directory / "features.afford"), seed=args.seed,
                            kernel=kernel)
-    afford.train(str(directory / "features.afford"), str(directory / "model.afford"), seed=args.seed, kernel=kernel)
-    return str(directory / "model.afford")
+    afford.train(str(directory / "features.afford"), model, seed=args.seed, kernel=kernel)
+    return model

@@ -24,8 +24,9 @@ SVM scoring the cut). Then:
   among go-forward's 20 most relevant features, and over all moves.
 
 Full mode: 5000 training interactions (seed S) and 2100 test interactions (300 environments,
-seed S + 1) unless ``--data``/``--test`` give explored files of ``traverse``; ``--quick``: 80
-and 40 environments (``--episodes``, ``--test-episodes`` set them).
+seed S + 1) unless ``--data``/``--test`` give explored files of ``traverse``; ``--quick``: 100
+and 20 environments (``--episodes``, ``--test-episodes`` set them; ``make reproduce``'s
+``--cache`` shares them with the furniture and accuracy scripts, which explore the same).
 
 Writes ``DIR/fig_5_7_5_13_relevance.{md,json,png}``; the JSON has ``maps`` (per move: the
 cell relevances, ``centre_of_relevance``, ``kept``), ``economy`` (rows ``method``, ``n``,
@@ -44,7 +45,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser  # noqa: E402
+from _common import commit, explored, parser  # noqa: E402
 
 NAME = "fig_5_7_5_13_relevance"
 SCENE = "traverse"
@@ -57,7 +58,7 @@ THESIS_CATEGORIES = {"distance": 0.65, "theta": 0.30, "phi": 0.05}
 PARTS = 10
 
 
-def load_or_explore(path: str | None, episodes: int, seed: int, workers: int):
+def load_or_explore(path: str | None, episodes: int, seed: int, args):
     import afford
 
     if path is not None:
@@ -65,7 +66,7 @@ def load_or_explore(path: str | None, episodes: int, seed: int, workers: int):
         if data.result is None or "go-forward" not in data.behavior_names:
             sys.exit(f"error: {path} holds no traverse interactions with the robot's results")
         return data
-    return afford.explore(SCENE, episodes=episodes, seed=seed, workers=workers)
+    return explored(SCENE, args, seed=seed, episodes=episodes)
 
 
 def relevance_maps(relevance: dict, spec) -> dict:
@@ -165,8 +166,8 @@ def main() -> None:
     ap = parser(__doc__)
     ap.add_argument("--data", default=None, help="explored traverse interactions to learn from (default: explore)")
     ap.add_argument("--test", default=None, help="explored traverse interactions to test on (default: explore)")
-    ap.add_argument("--episodes", type=int, default=None, help="training environments to explore (default 715; quick 80)")
-    ap.add_argument("--test-episodes", type=int, default=None, help="test environments to explore (default 300; quick 40)")
+    ap.add_argument("--episodes", type=int, default=None, help="training environments to explore (default 715; quick 100)")
+    ap.add_argument("--test-episodes", type=int, default=None, help="test environments to explore (default 300; quick 20)")
     args = ap.parse_args()
     for flag, v in (("--episodes", args.episodes), ("--test-episodes", args.test_episodes)):
         if v is not None and v < PARTS:
@@ -180,8 +181,8 @@ def main() -> None:
     from afford.learn.affordances import rank_features
 
     try:
-        train = load_or_explore(args.data, args.episodes or (80 if args.quick else 715), args.seed, args.workers)
-        test = load_or_explore(args.test, args.test_episodes or (40 if args.quick else 300), args.seed + 1, args.workers)
+        train = load_or_explore(args.data, args.episodes or (100 if args.quick else 715), args.seed, args)
+        test = load_or_explore(args.test, args.test_episodes or (20 if args.quick else 300), args.seed + 1, args)
         scene = afford.make_scene(SCENE)
         relevance = rank_features(train, train.result.astype(int), kernel="linear", seed=args.seed)
         spec = scene.config.grid

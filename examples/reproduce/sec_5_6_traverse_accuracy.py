@@ -8,7 +8,9 @@ traverse scene this explores a training and a test set (seeds S and S + 1), lear
 ``afford select-features | afford train`` does (ReliefF with its cross-validated cut, the
 scene's linear SVM), and scores each move on the test set beside a random forest trained
 on the same features. Full mode: 5000 training and 1400 test interactions per scene, as the
-README's figures; ``--quick``: 60 and 20 environments (minutes, for ``make reproduce``).
+README's figures; ``--quick``: 100 and 20 environments (minutes, for ``make reproduce``, whose
+``--cache`` shares the training sets and models with the scripts of figure 5.5 and tables 5.1
+and 5.2, which learn from the same ones).
 
 Writes ``DIR/sec_5_6_traverse_accuracy.{md,json,png}``; the JSON's ``rows`` hold one row per
 scene and move: ``scene``, ``behavior``, ``accuracy``, ``random_forest``, ``majority``,
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import json
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +30,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser  # noqa: E402
+from _common import commit, explored, parser, train_model  # noqa: E402
 
 NAME = "sec_5_6_traverse_accuracy"
 #: The thesis's figures (5.6.1 and 5.6.2), quoted from its text.
@@ -36,31 +39,21 @@ SECTION = {"traverse": "5.6.1", "traverse-body": "5.6.2.1", "traverse-ramps": "5
 
 
 def scene_rows(name: str, args) -> list[dict]:
-    from afford.learning import learner_settings
-    from afford.learn import baseline_scores
-    from afford.learn.affordances import parameters_of, predictor_inputs, rank_features, train_predictors
-    from afford.sim.explore import explore
-    from afford.sim.registry import make_scene
+    """The scene's model (``train_model``: explored, ``select-features``, ``train``) scored on
+    held-out environments of seed S + 1, as ``afford evaluate --baselines`` scores it."""
+    from afford.commands.evaluate import evaluate_model
 
-    scene = make_scene(name)
-    size = ({"episodes": 60}, {"episodes": 20}) if args.quick else ({"interactions": 5000}, {"interactions": 1400})
-    train = explore(scene, seed=args.seed, workers=args.workers, **size[0])
-    test = explore(scene, seed=args.seed + 1, workers=args.workers, **size[1])
-    kernel, folds = learner_settings(None, train)
-    labels = train.result.astype(int)
-    relevance = rank_features(train, labels, kernel=kernel, seed=args.seed)
-    selected = {b: r.selected_ for b, r in relevance.items()}
-    models = train_predictors(train, labels, selected, kernel=kernel, folds=folds, seed=args.seed)
+    import afford
+
+    with tempfile.TemporaryDirectory() as tmp:
+        model = afford.load_model(train_model(name, args, Path(tmp)))
+    test = explored(name, args, seed=args.seed + 1, **({"episodes": 20} if args.quick else {"interactions": 1400}))
     rows = []
-    for b, behavior in enumerate(train.behavior_names):
-        tr, te = np.flatnonzero(train.behavior == b), np.flatnonzero(test.behavior == b)
-        X = predictor_inputs(train.before_rows(tr), train.params[tr], selected[behavior], parameters_of(train, b))
-        Xt = predictor_inputs(test.before_rows(te), test.params[te], selected[behavior], parameters_of(test, b))
-        yt = test.result[te].astype(int)
-        base = baseline_scores(X, labels[tr], Xt, yt, random_state=args.seed)
-        rows.append({"scene": name, "behavior": behavior, "accuracy": round(float(np.mean(models[behavior].predict(Xt) == yt)), 4),
+    for behavior, e in evaluate_model(model, test, baselines=True, seed=args.seed).items():
+        base = e["baselines"]
+        rows.append({"scene": name, "behavior": behavior, "accuracy": round(float(e["accuracy"]), 4),
                      "random_forest": round(float(base["random_forest"]), 4), "majority": round(float(base["majority"]), 4),
-                     "n_test": int(te.size), "features_kept": int(len(selected[behavior])), "thesis": THESIS[name]})
+                     "n_test": int(e["n_test"]), "features_kept": int(len(model.selected[behavior])), "thesis": THESIS[name]})
     return rows
 
 
@@ -104,16 +97,19 @@ def write(rows: list[dict], args) -> None:
 def main() -> None:
     ap = parser(__doc__)
     ap.add_argument("--scenes", default=",".join(THESIS))
+    ap.add_argument("--episodes", type=int, default=None,
+                    help="training environments per scene (default: 5000 interactions; quick 100)")
     args = ap.parse_args()
     names = [s for s in args.scenes.split(",") if s]
     unknown = [s for s in names if s not in THESIS]
     if unknown:
         sys.exit(f"error: {unknown[0]!r} is not a traverse scene; choose from {', '.join(THESIS)}")
+    from afford import AffordError
     from afford.features.errors import DataError
 
     try:
         rows = [r for name in names for r in scene_rows(name, args)]
-    except DataError as exc:  # e.g. a quick run in which a move never failed
+    except (AffordError, DataError) as exc:  # e.g. a quick run in which a move never failed
         sys.exit(f"error: {exc}")
     write(rows, args)
 

@@ -27,7 +27,7 @@ What it runs (``grasp``; training interactions of seed S, held-out ones of seed 
   rate beside the mean predicted success.
 
 Full mode: 10 000 training and 5000 test interactions (about 2000 and 1000 per behaviour, as
-the thesis), the box every 10 degrees and alpha every 10 degrees. ``--quick``: 2000 and 800,
+the thesis), the box every 10 degrees and alpha every 10 degrees. ``--quick``: 1200 and 500,
 every 30 and 20 degrees. Writes ``DIR/tables_9_1_9_2_grasp.{md,json,png}``; the JSON's
 ``rows`` hold one row per cell, each with ``figure`` and, where the thesis gives one, ``thesis``.
 """
@@ -132,29 +132,51 @@ def _lifts(scene, spec, seed: int, behavior: str, alpha: float) -> bool:
     return sim.history[-1].outcomes[0] == scene.outcomes.index("lifted")
 
 
+def _liftable(seed: int) -> bool:
+    """Whether the object of scene seed ``seed``'s world is in view and some grasp lifts it at
+    some alpha of ``ORACLE_ALPHAS`` (each tried in a fresh world: ground truth)."""
+    import afford
+
+    scene = afford.make_scene(SCENE)
+    sim = afford.world(scene, seed=seed)
+    start = sim.state
+    if start.shape[0] != 1 or not start[0, scene.schema.visibility_index]:
+        return False
+    spec = sim.layout[0]
+    return any(_lifts(scene, spec, seed, b, a) for b in ("power-grasp", "precision-grasp") for a in ORACLE_ALPHAS)
+
+
 def plan_rows(model, args) -> tuple[list[dict], list[dict]]:
     """Criterion 4: plans that choose alpha, run in simulation on scenes some alpha lifts.
 
     Scenes are drawn from the seed's stream until ``args.plans`` of them hold an object that
     some (grasp, alpha) lifts, found by trying both grasps over ``ORACLE_ALPHAS`` in fresh
-    worlds. On each, a one-step plan for "the contact point 10 cm higher" is searched with
-    each alpha rule, executed in a fresh world of the same layout, and the lift read from
-    ground truth."""
+    worlds (``args.workers`` scenes at a time; the first ``args.plans`` in seed order are
+    used, whatever the workers). On each, a one-step plan for "the contact point 10 cm
+    higher" is searched with each alpha rule, executed in a fresh world of the same layout,
+    and the lift read from ground truth."""
+    from joblib import Parallel, delayed
+
     import afford
     from afford.plan.search import best_first
 
     scene = afford.make_scene(SCENE)
     rules = {rule: model.forward(alpha_rule=rule) for rule in PLAN_RULES}
-    runs, tried, seed = [], 0, args.seed * 100_000 + 7
-    while sum(1 for r in runs if r["rule"] == PLAN_RULES[0]) < args.plans and tried < 40 * args.plans:
-        seed, tried = seed + 1, tried + 1
+    first, limit = args.seed * 100_000 + 8, 40 * args.plans
+    liftable: list[int] = []
+    batch = 2 * max(1, args.workers)
+    with Parallel(n_jobs=args.workers) as parallel:
+        for a in range(0, limit, batch):
+            seeds = list(range(first + a, first + min(a + batch, limit)))
+            liftable += [s for s, ok in zip(seeds, parallel(delayed(_liftable)(s) for s in seeds)) if ok]
+            if len(liftable) >= args.plans:
+                break
+    liftable = liftable[: args.plans]
+    tried = (liftable[-1] - first + 1) if len(liftable) == args.plans else limit
+    runs = []
+    for seed in liftable:
         sim = afford.world(scene, seed=seed)
-        spec = sim.layout[0]
-        start = sim.state
-        if start.shape[0] != 1 or not start[0, model.schema.visibility_index]:
-            continue
-        if not any(_lifts(scene, spec, seed, b, a) for b in ("power-grasp", "precision-grasp") for a in ORACLE_ALPHAS):
-            continue
+        spec, start = sim.layout[0], sim.state
         goal = afford.parse_goal(f"0:cp_z>{float(start[0, model.schema.index('cp_z')]) + 0.10:.4f}", model.schema)
         for rule, fm in rules.items():
             plan = best_first(fm, start, goal, max_depth=1)
@@ -181,8 +203,8 @@ def plan_rows(model, args) -> tuple[list[dict], list[dict]]:
 
 def main() -> None:
     ap = parser(__doc__)
-    ap.add_argument("--train", type=int, default=None, help="training interactions (default 10000, quick 2000)")
-    ap.add_argument("--test", type=int, default=None, help="held-out interactions (default 5000, quick 800)")
+    ap.add_argument("--train", type=int, default=None, help="training interactions (default 10000, quick 1200)")
+    ap.add_argument("--test", type=int, default=None, help="held-out interactions (default 5000, quick 500)")
     ap.add_argument("--plans", type=int, default=None, help="liftable scenes to plan on (default 100, quick 6)")
     ap.add_argument("--model", default=None, help="a trained grasp model: skip exploring and learning (tables and "
                     "accuracy need the data, so only the map and the plans are made)")
@@ -190,8 +212,8 @@ def main() -> None:
     args.plans = args.plans if args.plans is not None else (6 if args.quick else 100)
     import afford
 
-    n_train = args.train or (2000 if args.quick else 10000)
-    n_test = args.test or (800 if args.quick else 5000)
+    n_train = args.train or (1200 if args.quick else 10000)
+    n_test = args.test or (500 if args.quick else 5000)
     if args.model:
         model = afford.load_model(args.model)
         plans, runs = plan_rows(model, args)
