@@ -62,6 +62,22 @@ def explored(scene: str, args, *, seed: int, **size):
     return data
 
 
+def parallel(fn, items, workers: int, *shared) -> list:
+    """``[fn(*shared, item) for item in items]``, in order, on ``workers`` processes (joblib),
+    the items dealt out in contiguous chunks so that ``shared`` (a model, say) is sent once
+    per chunk. For independent simulator runs: each item carries its own seed, so the
+    results do not depend on ``workers``."""
+    from joblib import Parallel, delayed
+
+    items = list(items)
+    if workers <= 1 or len(items) < 2:
+        return [fn(*shared, item) for item in items]
+    size = -(-len(items) // (4 * workers))
+    chunks = [items[a:a + size] for a in range(0, len(items), size)]
+    run = lambda chunk, *shared: [fn(*shared, item) for item in chunk]  # noqa: E731
+    return [r for part in Parallel(n_jobs=workers)(delayed(run)(c, *shared) for c in chunks) for r in part]
+
+
 def stream_parser(doc: str, situations: str):
     """:func:`parser` with the overrides of the curiosity scripts' candidate streams:
     ``--candidates``, ``--test-size`` (test ``situations``) and ``--orderings``."""

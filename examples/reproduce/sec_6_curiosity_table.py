@@ -26,7 +26,8 @@ A diagnosis beside it: the same strategies learning the world's own outcome labe
 from) instead of the discovered categories, to tell the categories' part in what
 curiosity gains from the table's.
 
-Full mode: 1500 candidates, 600 test objects, 10 orderings; ``--quick``: 450, 250, 3.
+Full mode: 1500 candidates, 600 test objects, 10 orderings; ``--quick``: 300, 150, 3 (its
+checkpoints end at 150 interactions).
 
 Writes ``DIR/sec_6_curiosity_table.{md,json,png}``; the JSON's ``rows`` hold one row per
 labels, behaviour, strategy and checkpoint: ``labels`` ("discovered", or "outcome" for
@@ -94,7 +95,7 @@ def run(args) -> dict:
     from afford.learning import clustering_settings
     from afford.sim.registry import make_scene
 
-    n, t, orderings = (450, 250, 3) if args.quick else (1500, 600, 10)
+    n, t, orderings = (300, 150, 3) if args.quick else (1500, 600, 10)
     n, t, orderings = args.candidates or n, args.test_size or t, args.orderings or orderings
     scene = make_scene("table")
     X, E, Y = stream(scene, n, args.seed, args.workers)
