@@ -132,20 +132,31 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _cpu_seconds(pid: int) -> float:
+    """CPU time (user + system) process ``pid`` has used; 0 once it is gone."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def _explore_until_workers(tmp_path):
     import time
 
     proc = subprocess.Popen([*AFFORD, "explore", "--episodes", "400", "--workers", "2", "-o", "x.afford"],
                             cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    deadline = time.time() + 60
+    deadline = time.time() + 90
     while time.time() < deadline:
         kids = _descendants(proc.pid)
-        if len([k for k in kids if "popen_loky" in Path(f"/proc/{k}/cmdline").read_text(errors="ignore")]) >= 2:
-            time.sleep(1.0)  # the workers have started their first chunks
+        workers = [k for k in kids if "popen_loky" in Path(f"/proc/{k}/cmdline").read_text(errors="ignore")]
+        # a worker asks to die with its parent when it starts its first chunk, after its
+        # imports (about 1.5 s of CPU); on a loaded machine a fixed sleep was not enough
+        if len(workers) >= 2 and all(_cpu_seconds(k) >= 4.0 for k in workers):
             return proc, _descendants(proc.pid)
         time.sleep(0.2)
     proc.kill()
-    pytest.fail("explore --workers 2 started no workers within 60 s")
+    pytest.fail("explore --workers 2 started no busy workers within 90 s")
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG is Linux's")
