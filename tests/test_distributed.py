@@ -74,7 +74,7 @@ def test_an_interrupted_run_keeps_its_episodes_and_resumes_to_the_same_bytes(one
     proc, journal = _start_and_wait(tmp_path, "r.afford", 60, at_least=8)
     os.kill(proc.pid, sig)
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 130 and "Traceback" not in err
+    assert proc.returncode == 130 and "Traceback" not in err, err
     kept = _records(journal)
     assert 8 <= kept < 60
     assert f"{kept} finished episodes are kept in r.afford.partial" in err and "--resume" in err
