@@ -44,7 +44,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, parser  # noqa: E402
+from _common import commit, parallel, parser  # noqa: E402
 
 NAME = "tables_9_1_9_2_grasp"
 #: The alphas the oracle tries to find whether a scene's object can be lifted at all.
@@ -155,8 +155,6 @@ def plan_rows(model, args) -> tuple[list[dict], list[dict]]:
     used, whatever the workers). On each, a one-step plan for "the contact point 10 cm
     higher" is searched with each alpha rule, executed in a fresh world of the same layout,
     and the lift read from ground truth."""
-    from joblib import Parallel, delayed
-
     import afford
     from afford.plan.search import best_first
 
@@ -165,12 +163,11 @@ def plan_rows(model, args) -> tuple[list[dict], list[dict]]:
     first, limit = args.seed * 100_000 + 8, 40 * args.plans
     liftable: list[int] = []
     batch = 2 * max(1, args.workers)
-    with Parallel(n_jobs=args.workers) as parallel:
-        for a in range(0, limit, batch):
-            seeds = list(range(first + a, first + min(a + batch, limit)))
-            liftable += [s for s, ok in zip(seeds, parallel(delayed(_liftable)(s) for s in seeds)) if ok]
-            if len(liftable) >= args.plans:
-                break
+    for a in range(0, limit, batch):
+        seeds = list(range(first + a, first + min(a + batch, limit)))
+        liftable += [s for s, ok in zip(seeds, parallel(_liftable, seeds, args.workers)) if ok]
+        if len(liftable) >= args.plans:
+            break
     liftable = liftable[: args.plans]
     tried = (liftable[-1] - first + 1) if len(liftable) == args.plans else limit
     runs = []
