@@ -297,12 +297,19 @@ def explore(scene, *, episodes: int | None = None, interactions: int | None = No
     except BaseException as exc:
         if book is None:
             raise
-        book.close()
+        interrupted = isinstance(exc, KeyboardInterrupt)
+        try:
+            book.close()
+        except OSError:
+            # an interruption can land inside a record's write; the reader drops a record cut
+            # short, so a failed flush must not turn Ctrl-C into another error
+            if not interrupted:
+                raise
         if book.created and not book.kept:  # nothing was kept: leave no trace
             book.remove()
             raise
-        if isinstance(exc, KeyboardInterrupt):
-            n = len(book.kept)
+        if interrupted:
+            n = book.count()  # what the journal holds whole on disk, which --resume will find
             raise Interrupted(f"interrupted; {n} finished episode{'s are' if n != 1 else ' is'} kept in {book.dir}: "
                               "run the same command with --resume to go on") from None
         raise

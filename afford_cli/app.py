@@ -92,6 +92,12 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(130)
     except BrokenPipeError:  # a pipeline reader went away: not our error to report
         sys.exit(1)
+    finally:
+        # the command has ended and its exit code is set: a Ctrl-C or SIGTERM that lands
+        # while the interpreter shuts down (joining the progress bar's thread, say) would
+        # otherwise kill the process by the signal and hide that code
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
 
 
 if __name__ == "__main__":  # pragma: no cover

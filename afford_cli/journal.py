@@ -75,7 +75,7 @@ class Journal:
             raise AffordError(f"{d} is in the way of the exploration's journal: it is not a folder")
         if d.exists():
             if not resume:
-                n = journal._count()
+                n = journal.count()
                 raise AffordError(f"{d} holds {n} finished episode{'s' * (n != 1)} of an interrupted exploration: "
                                   "give --resume to finish it, or remove that folder to start afresh")
             journal._open_existing()
@@ -155,7 +155,8 @@ class Journal:
                 offset += _HEAD.size + length
                 yield episode, payload, offset
 
-    def _count(self) -> int:
+    def count(self) -> int:
+        """Finished episodes whole on disk (a record a write was cut short in is not one)."""
         return len({e for e, _, _ in self._records()})
 
     def _read(self) -> int:
@@ -196,10 +197,12 @@ class Journal:
 
     def close(self) -> None:
         if self._log is not None:
-            self._log.flush()
-            os.fsync(self._log.fileno())
-            self._log.close()
-            self._log = None
+            log, self._log = self._log, None
+            try:
+                log.flush()
+                os.fsync(log.fileno())
+            finally:
+                log.close()
 
     def remove(self) -> None:
         """The output is written whole: the journal has done its work."""

@@ -46,7 +46,7 @@ def one_shot(tmp_path_factory):
 def _records(journal: Path) -> int:
     from afford.journal import Journal
 
-    return Journal(journal, {})._count()
+    return Journal(journal, {}).count()
 
 
 def _start_and_wait(tmp_path: Path, out: str, episodes: int, at_least: int):
@@ -289,3 +289,38 @@ def test_two_runs_never_write_one_journal(tmp_path):
 
     with pytest.raises(Interrupted, match="8 finished episodes are kept"):  # the refused run took nothing
         afford.explore("table", episodes=60, seed=5, journal=journal, progress=second_run_meanwhile)
+
+
+def test_an_interruption_inside_a_records_write_still_keeps_the_whole_ones(tmp_path, monkeypatch):
+    """Ctrl-C can land while a record is half written, and the flush that follows can fail:
+    the run still ends as an interruption, names what the journal holds whole, and resumes."""
+    import afford
+    from afford import journal as journal_module
+    from afford.datasets import interactions_members
+    from afford.errors import Interrupted
+
+    real_append = journal_module.Journal.append
+    calls = []
+
+    def append_cut_short(self, pairs):
+        calls.append(len(pairs))
+        if len(calls) < 2:
+            return real_append(self, pairs)
+        self._log.write(journal_module._HEAD.pack(journal_module._MAGIC, 99, 1 << 20, 0) + b"half a record")
+        raise KeyboardInterrupt
+
+    def fsync_fails(fd):
+        raise OSError(5, "Input/output error")
+
+    monkeypatch.setattr(journal_module.Journal, "append", append_cut_short)
+    monkeypatch.setattr(journal_module.os, "fsync", fsync_fails)
+    journal = tmp_path / "h.partial"
+    with pytest.raises(Interrupted, match="8 finished episodes are kept"):
+        afford.explore("table", episodes=24, seed=5, journal=journal)
+    assert calls == [8, 8]
+    monkeypatch.undo()
+    assert _records(journal) == 8  # the half record is not one
+    resumed = afford.explore("table", episodes=24, seed=5, journal=journal, resume=True)
+    one = afford.explore("table", episodes=24, seed=5)
+    a, b = interactions_members(one)[0], interactions_members(resumed)[0]
+    assert a.keys() == b.keys() and all(a[k].tobytes() == b[k].tobytes() for k in a)
