@@ -44,19 +44,15 @@ bench: $(STAMP)
 	$(PY) benchmarks/emulate.py
 	$(PY) benchmarks/curiosity.py
 
-# every thesis figure's script in its quick mode, then reproduce/index.md linking them
-# (the scripts share explorations and models of the same recipe through reproduce/.cache,
-# emptied before and after, so nothing from an older checkout is ever reused)
+# every thesis figure's script in its quick mode, then reproduce/index.md linking them. A
+# chapter's scripts run one after another (they share explorations and models of the same
+# recipe through reproduce/.cache, emptied before and after, so nothing from an older
+# checkout is ever reused); chapters run in REPRODUCE_LANES lanes side by side (_run.py there)
+REPRODUCE_LANES ?= 2
 reproduce: $(STAMP)
 	@rm -rf reproduce/.cache && mkdir -p reproduce
-	@begin=$$(date +%s); for script in examples/reproduce/[!_]*.py; do echo "== $$script"; start=$$(date +%s); \
-	  $(PY) $$script --quick --out reproduce --cache reproduce/.cache || exit 1; \
-	  echo "== $$script took $$(( $$(date +%s) - start )) s"; done; \
-	  echo "== every quick mode took $$(( $$(date +%s) - begin )) s"
-	@rm -rf reproduce/.cache
-	@{ echo "# Thesis figures reproduced (quick mode)"; echo; \
-	  for f in reproduce/*.md; do [ "$$f" = reproduce/index.md ] || echo "- [$$(head -n 1 $$f | sed 's/^# //')]($$(basename $$f))"; done; } > reproduce/index.md
-	@echo "-> reproduce/index.md"
+	@$(PY) examples/reproduce/_run.py --quick --out reproduce --cache reproduce/.cache --lanes $(REPRODUCE_LANES); \
+	  status=$$?; rm -rf reproduce/.cache; exit $$status
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache benchmarks/results reproduce

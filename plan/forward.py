@@ -611,13 +611,42 @@ class ForwardModel:
             classes, proba = self.distribution(state[i], b, alpha)
             choices.append([(int(c), float(p)) for c, p in zip(classes, proba) if p >= floor] or [(None, 1.0)])
         out = []
-        for combo in product(*choices):
-            p = float(np.prod([q for _, q in combo]))
-            if p < floor:
-                continue
+        for combo, p in _joint(choices, floor):
             cats: list = [None] * state.shape[0]
-            for i, (c, _) in zip(rows, combo):
+            for i, c in zip(rows, combo):
                 cats[i] = c
             out.append(Outcome(tuple(cats), p, self.apply(state, SCENE, b, cats, alpha)))
         out.sort(key=lambda o: -o.probability)
         return out
+
+
+def _joint(choices: list[list[tuple]], floor: float) -> list[tuple[tuple, float]]:
+    """The combinations of ``itertools.product(*choices)`` (each choice a (category,
+    probability) pair) whose probability, the product of theirs taken left to right, is at
+    least ``floor``: (categories, probability), in ``product``'s order and with its bits.
+
+    A search meets thousands of scenes; with five objects and four likely categories each
+    the product has a thousand combinations, nearly all below the floor. A partial product
+    that the rest of the row's best choices cannot lift back to the floor ends its branch.
+    """
+    n = len(choices)
+    best = [max(q for _, q in c) for c in choices]
+    reach = [1.0] * (n + 1)  # the largest product rows i.. can still give
+    for i in range(n - 1, -1, -1):
+        reach[i] = reach[i + 1] * best[i]
+    out: list[tuple[tuple, float]] = []
+    margin = 1.0 - 1e-9  # the bound's own rounding never ends a branch that makes the floor
+
+    def grow(i: int, cats: tuple, p: float) -> None:
+        if i == n:
+            if p >= floor:
+                out.append((cats, p))
+            return
+        for c, q in choices[i]:
+            pq = p * q
+            if pq * reach[i + 1] < floor * margin:
+                continue
+            grow(i + 1, cats + (c,), pq)
+
+    grow(0, (), 1.0)
+    return out

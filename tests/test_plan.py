@@ -619,3 +619,30 @@ def test_slow_searches_and_assessments_show_a_bar_on_stderr_and_quick_ones_do_no
     with watching(progress_bars(Output())):  # nothing here takes seconds
         rank_plans(aiming(), scene(0.0), g, 2, rollouts=30, max_nodes=500)
     assert capsys.readouterr().err == ""
+
+
+def test_a_scenes_joint_outcomes_are_the_full_products_above_the_floor_in_its_order_and_bits():
+    """A move changes every object: its outcomes are the product of each object's categories.
+    The search enumerates only the branches that can still reach the floor; what it keeps
+    must be exactly what filtering the whole product keeps."""
+    import itertools
+    import math
+
+    from afford.plan.forward import _joint
+
+    rng = np.random.default_rng(7)
+    for trial in range(400):
+        n = int(rng.integers(0, 6))
+        choices = []
+        for _ in range(n):
+            k = int(rng.integers(1, 5))
+            p = rng.dirichlet(np.ones(k) * rng.uniform(0.2, 2.0))
+            kept = [(int(c), float(q)) for c, q in enumerate(p) if q >= 0.01] or [(None, 1.0)]
+            choices.append(kept)
+        floor = float(rng.choice([0.0, 0.01, 0.05, 0.2]))
+        full = [(tuple(c for c, _ in combo), math.prod(q for _, q in combo)) for combo in itertools.product(*choices)]
+        want = [(c, p) for c, p in full if p >= floor]
+        got = _joint(choices, floor)
+        assert got == want and all(type(p) is float for _, p in got)
+    # five objects of four likely categories: most of the thousand combinations are never built
+    assert len(_joint([[(0, 0.4), (1, 0.3), (2, 0.2), (3, 0.1)]] * 5, 0.01)) < 100

@@ -56,6 +56,44 @@ def test_a_cache_hands_a_later_script_the_same_exploration_without_exploring_aga
         _common.explored("traverse-gaps", argparse.Namespace(cache=None, workers=1), seed=3, episodes=2)
 
 
+def test_make_reproduce_runs_a_chapters_scripts_in_order_and_chapters_side_by_side(tmp_path):
+    """_run.py: one chapter's scripts share a cache, so they run one after another; other
+    chapters run beside them; the index links every page; a failing script fails the run."""
+    folder = tmp_path / "scripts"
+    folder.mkdir()
+    # each script leaves its page and a stamp of when it ran; fig_5_b needs fig_5_a's output
+    body = ("import sys, time, pathlib\n"
+            "out = pathlib.Path(sys.argv[sys.argv.index('--out') + 1])\n"
+            "assert sys.argv[sys.argv.index('--cache') + 1] == 'CACHE' and '--quick' in sys.argv\n"
+            "{check}"
+            "start = time.time(); time.sleep(1.0)\n"
+            "(out / '{name}.md').write_text('# Figure {name}\\n')\n"
+            "(out / '{name}.when').write_text(f'{{start}} {{time.time()}}')\n"
+            "print('made {name}')\n")
+    scripts = {"fig_5_a": "", "table_5_b": "assert (out / 'fig_5_a.md').exists(), 'ran before fig_5_a'\n",
+               "table_7_c": "", "_common": "raise SystemExit('a helper is not a script')\n"}
+    for name, check in scripts.items():
+        (folder / f"{name}.py").write_text(body.format(name=name, check=check))
+    out = tmp_path / "out"
+    run = subprocess.run([sys.executable, str(SCRIPTS / "_run.py"), "--quick", "--out", str(out), "--cache", "CACHE",
+                          "--dir", str(folder)], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.count(".py took ") == 3 and "made fig_5_a" in run.stdout
+    when = {n: [float(x) for x in (out / f"{n}.when").read_text().split()] for n in ("fig_5_a", "table_5_b", "table_7_c")}
+    assert when["fig_5_a"][1] <= when["table_5_b"][0]  # one chapter: one after another
+    assert when["table_7_c"][0] < when["fig_5_a"][1]  # another chapter: beside it
+    index = (out / "index.md").read_text()
+    assert "[Figure fig_5_a](fig_5_a.md)" in index and "[Figure table_7_c](table_7_c.md)" in index
+    assert not (out / "_common.when").exists()
+    # a script that fails stops the run: exit 1, its output shown, no index
+    (folder / "fig_5_a.py").write_text("raise SystemExit('the physics broke')\n")
+    out2 = tmp_path / "out2"
+    bad = subprocess.run([sys.executable, str(SCRIPTS / "_run.py"), "--out", str(out2), "--cache", "CACHE", "--lanes", "1",
+                          "--dir", str(folder)], capture_output=True, text=True, timeout=60)
+    assert bad.returncode == 1 and "the physics broke" in bad.stdout and "fig_5_a.py failed" in bad.stderr
+    assert not (out2 / "index.md").exists() and not (out2 / "table_5_b.md").exists()
+
+
 def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     script = SCRIPTS / "fig_6_5_6_6_curiosity.py"
     subprocess.run([sys.executable, str(script), "--quick", "--candidates", "130", "--test-size", "60", "--orderings", "2",
