@@ -99,11 +99,16 @@ def main(argv: list[str] | None = None) -> int:
                         failed.append(script.name)
                         return
 
-    threads = [threading.Thread(target=lane) for _ in range(min(args.lanes, len(todo)))]
+    threads = [threading.Thread(target=lane, daemon=True) for _ in range(min(args.lanes, len(todo)))]
     for t in threads:
         t.start()
-    for t in threads:
-        t.join()
+    try:
+        for t in threads:
+            while t.is_alive():
+                t.join(0.5)  # a bare join() would not hear Ctrl-C until the lane ends
+    except KeyboardInterrupt:  # the scripts, in the terminal's process group, heard it too
+        print("error: interrupted; the pages written so far are in " + args.out, file=sys.stderr)
+        return 130
     print(f"== every {'quick mode' if args.quick else 'script'} took {time.monotonic() - begin:.0f} s "
           f"({args.lanes} lane{'s' * (args.lanes != 1)})")
     if failed:
