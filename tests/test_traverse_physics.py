@@ -321,3 +321,14 @@ def test_a_chairs_seat_below_the_robots_top_stops_it():
 
     assert not _go_forward_through(place(chair(), 0.6, 0.0, 90.0))
     assert _go_forward_through(place(chair(), 0.6, 0.7, 90.0))  # beside the path
+
+
+def test_explored_ramps_reach_the_slopes_that_stop_the_robot_on_an_oblique_ramp():
+    """Table 5.1 raises a ramp to 40 degrees, and an oblique ramp stops the robot only past
+    25-38: exploration must meet steep oblique ramps, or the model cannot place that boundary."""
+    rng = np.random.default_rng(11)
+    ramps = [sample_ramp(rng).ramps[0] for _ in range(400)]
+    slopes = np.array([r.slope for r in ramps])
+    assert slopes.min() >= 2.0 and slopes.max() <= 40.0
+    steep_oblique = [r for r in ramps if r.slope > 32.0 and 30.0 <= abs(r.yaw) <= 60.0]
+    assert len(steep_oblique) >= 10

@@ -48,8 +48,8 @@ SWEEP = Sweep(
     behaviors=("turn-left-20", "go-forward", "turn-right-20"), thesis=THESIS, layout=ramp,
     caveat=("The thesis's column icons are lost in our copy; its columns are set beside ours in the order "
             "turn-left-20, go-forward, turn-right-20, and its sign of orientation may be the opposite of ours "
-            "(ours: the direction the ramp climbs, left positive). Exploration drew slopes of 2-30 degrees, so "
-            "predictions above 30 degrees extrapolate."))
+            "(ours: the direction the ramp climbs, left positive). Exploration draws slopes of 2-40 degrees, the "
+            "range the ramp is raised over here."))
 
 
 if __name__ == "__main__":

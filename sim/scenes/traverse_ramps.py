@@ -5,7 +5,7 @@ What the robot has
 
 What is randomised (per episode)
     One static ramp: its toe 0.3-0.9 m ahead and up to 0.5 m to either side, turned -90..90 deg from the robot's heading,
-    0.5-1.5 m wide and long, 2-30 deg steep (``sim.traverse.sample_ramp``). Whether the
+    0.5-1.5 m wide and long, 2-40 deg steep (``sim.traverse.sample_ramp``). Whether the
     robot climbs it is what its wheels' traction and its weight make of the slope.
 
 What the behaviours do
