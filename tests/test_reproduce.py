@@ -92,6 +92,11 @@ def test_make_reproduce_runs_a_chapters_scripts_in_order_and_chapters_side_by_si
                           "--dir", str(folder)], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 1 and "the physics broke" in bad.stdout and "fig_5_a.py failed" in bad.stderr
     assert not (out2 / "index.md").exists() and not (out2 / "table_5_b.md").exists()
+    for bad_args, message in ((["--lanes", "0"], "error: --lanes and --workers must be at least 1"),
+                              (["no_such_script"], "error: no reproduction script 'no_such_script'")):
+        bad = subprocess.run([sys.executable, str(SCRIPTS / "_run.py"), "--dir", str(folder), *bad_args],
+                             capture_output=True, text=True, timeout=60)
+        assert bad.returncode == 1 and bad.stderr.strip().startswith(message) and len(bad.stderr.strip().splitlines()) == 1
 
 
 def test_curiosity_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):

@@ -67,7 +67,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--dir", type=Path, default=HERE, help="where the scripts are (default: beside this file)")
     args = ap.parse_args(argv)
     if args.lanes < 1 or args.workers < 1:
-        ap.error("--lanes and --workers must be at least 1")
+        print("error: --lanes and --workers must be at least 1", file=sys.stderr)
+        return 1
     todo = groups(scripts(args.scripts, args.dir))
     Path(args.out).mkdir(parents=True, exist_ok=True)
     lock = threading.Lock()
