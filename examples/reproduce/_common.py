@@ -115,10 +115,10 @@ def learner_note(args) -> str:
     return ", a random forest" if kernel == "forest" else f", an {kernel} SVM" if kernel == "rbf" else f", a {kernel} SVM"
 
 
-def train_model(scene: str, args, directory: Path) -> str:
+def train_model(scene: str, args, directory: Path, interactions: int = 5000) -> str:
     """Explore ``scene`` and learn as ``afford select-features | afford train`` does; the
     model's path in ``directory``. ``args.episodes`` sizes the exploration if given; else 100
-    environments in quick mode and 5000 interactions in full mode (the README's models).
+    environments in quick mode and ``interactions`` in full mode (5000: the README's models).
     With ``args.cache``, the exploration and the model are taken from there when a script
     before made them from the same recipe, and left there for the next.
     ``args.kernel``, where a script has it, is the learner (None: the scene's); a forest
@@ -127,7 +127,7 @@ def train_model(scene: str, args, directory: Path) -> str:
 
     episodes = getattr(args, "episodes", None)
     size = {"episodes": episodes} if episodes else (
-        {"episodes": 100} if args.quick else {"interactions": 5000})
+        {"episodes": 100} if args.quick else {"interactions": interactions})
     kernel = getattr(args, "kernel", None)
     cached = _cached(args, {"scene": scene, "seed": args.seed, **size, "kernel": kernel}, "model")
     if cached is not None and cached.exists():

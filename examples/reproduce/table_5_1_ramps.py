@@ -1,15 +1,17 @@
 """Thesis Table 5.1: the critical slope of a ramp, predicted and actual, by orientation and move.
 
     python examples/reproduce/table_5_1_ramps.py [--quick] [--seed S] [--out DIR] [--workers W]
-        [--model M] [--episodes N] [--orientations -45,...,45]
+        [--model M] [--episodes N] [--orientations -45,...,45] [--kernel linear|rbf|forest]
 
 A ramp (toe 45 cm ahead of the robot's centre, 1 m wide, 1.5 m long) is turned to seven
 orientations (its climbing direction, left positive) and raised from 1 to 40 degrees. For
 turn-left-20, go-forward and turn-right-20 the script finds the slope above which the move
 fails: in PhysX by a sweep and a bisection (``actual``), and by the model trained on
-``traverse-ramps`` as the slope rises (``predicted``, see ``_critical.py``). Full mode: a
-model from 5000 interactions of seed S, predictions every 0.5 degrees, bisection to 0.25
-degrees; ``--quick``: 100 environments, every degree (minutes, for ``make reproduce``).
+``traverse-ramps`` as the slope rises (``predicted``, see ``_critical.py``). The model is a
+random forest on all 3900 grid features (``--kernel linear`` gives the thesis's linear SVM on
+ReliefF's cut). Full mode: 20 000 interactions of seed S, predictions every 0.5 degrees,
+bisection to 0.25 degrees; ``--quick``: 100 environments, every degree (minutes, for
+``make reproduce``).
 
 Writes ``DIR/table_5_1_ramps.{md,json,png}``; the JSON's ``rows`` hold one row per cell:
 ``orientation``, ``behavior``, ``predicted``, ``actual`` (null where none exists), ``error``,

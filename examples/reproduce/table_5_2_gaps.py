@@ -1,15 +1,17 @@
 """Thesis Table 5.2: the critical width of a gap, predicted and actual, by orientation and move.
 
     python examples/reproduce/table_5_2_gaps.py [--quick] [--seed S] [--out DIR] [--workers W]
-        [--model M] [--episodes N] [--orientations -45,...,45]
+        [--model M] [--episodes N] [--orientations -45,...,45] [--kernel linear|rbf|forest]
 
 A gap in the floor (its near edge 25 cm ahead of the robot's front where it crosses the
 robot's heading) is turned to seven orientations (0: square to the heading, left positive)
 and widened from 2 to 60 cm. For go-forward, turn-left-20 and turn-right-20 the script finds
 the width above which the move fails: in PhysX by a sweep and a bisection (``actual``), and
 by the model trained on ``traverse-gaps`` as the gap widens (``predicted``, see
-``_critical.py``). Full mode: a model from 5000 interactions of seed S, predictions every
-centimetre, bisection to 0.5 cm; ``--quick``: 100 environments, every 2 cm.
+``_critical.py``). The model is a random forest on all 3900 grid features (``--kernel
+linear`` gives the thesis's linear SVM on ReliefF's cut). Full mode: 20 000 interactions of
+seed S, predictions every centimetre, bisection to 0.5 cm; ``--quick``: 100 environments,
+every 2 cm.
 
 Writes ``DIR/table_5_2_gaps.{md,json,png}``; the JSON's ``rows`` hold one row per cell:
 ``orientation``, ``behavior``, ``predicted``, ``actual`` (null where none exists), ``error``,
