@@ -200,6 +200,7 @@ def _critical(tmp_path, name: str) -> dict:
                     "--workers", "2", "--out", str(tmp_path)], check=True, capture_output=True)
     doc = json.loads((tmp_path / f"{name}.json").read_text())
     assert doc["seed"] == 1 and doc["quick"] and doc["commit"]
+    assert doc["kernel"] == "forest" and "a random forest" in (tmp_path / f"{name}.md").read_text()
     behaviors = [r["behavior"] for r in doc["rows"][:3]]
     assert [(r["orientation"], r["behavior"]) for r in doc["rows"]] == [(o, b) for o in (0.0, 45.0) for b in behaviors]
     assert set(behaviors) == {"go-forward", "turn-left-20", "turn-right-20"}
@@ -243,6 +244,7 @@ def test_fig_5_5_finds_the_robots_body_in_physx_and_maps_the_model_beside_it(tmp
     doc = json.loads((tmp_path / "fig_5_5_body.json").read_text())
     actual = {r["boundary"]: r["actual"] for r in doc["rows"]}
     assert set(actual) == {"left", "right", "depth", "height"} and doc["step"] == 0.09
+    assert doc["kernel"] == "forest"
     # a 10 cm box blocks the 33 cm-wide robot as far to the left as to the right of its path (16.5 + 5 cm),
     assert 0.15 < actual["left"] < 0.30 and abs(actual["left"] + actual["right"]) <= 0.09
     # it is driven under when hung above the 47 cm body, and is not reached when far ahead

@@ -115,6 +115,14 @@ def learner_note(args) -> str:
     return ", a random forest" if kernel == "forest" else f", an {kernel} SVM" if kernel == "rbf" else f", a {kernel} SVM"
 
 
+def learner_fields(args) -> dict:
+    """What a script's JSON records of its learner: ``kernel`` (None with ``--model``; the
+    scripts with ``--kernel`` learn the traverse scenes, whose own learner is the linear SVM)
+    and ``learner``, :func:`learner_note`'s phrase for its report."""
+    kernel = None if getattr(args, "model", None) else (getattr(args, "kernel", None) or "linear")
+    return {"kernel": kernel, "learner": learner_note(args)}
+
+
 def train_model(scene: str, args, directory: Path, interactions: int = 5000) -> str:
     """Explore ``scene`` and learn as ``afford select-features | afford train`` does; the
     model's path in ``directory``. ``args.episodes`` sizes the exploration if given; else 100

@@ -35,7 +35,7 @@ from typing import Callable
 
 import numpy as np
 
-from _common import commit, learner_note, learner_option, parser, train_model
+from _common import commit, learner_fields, learner_option, parser, train_model
 
 
 @dataclass(frozen=True)
@@ -226,8 +226,8 @@ def run(sweep: Sweep, args) -> dict:
                      if r.get("thesis") and None not in (r["thesis"]["predicted"], r["thesis"]["actual"])]
     summary["thesis_max_abs_error"] = max(thesis_errors) if thesis_errors else None
     return {"name": sweep.name, "table": sweep.table, "scene": sweep.scene, "seed": args.seed, "commit": commit(),
-            "quick": args.quick, "model": args.model, "kernel": None if args.model else (args.kernel or "linear"),
-            "learner": learner_note(args), "quantity": sweep.quantity, "unit": sweep.unit,
+            "quick": args.quick, "model": args.model, **learner_fields(args),
+            "quantity": sweep.quantity, "unit": sweep.unit,
             "range": [sweep.lo, sweep.hi], "model_step": step, "tolerance": sweep.tolerance,
             "summary": summary, "rows": rows, "curves": curves}
 
@@ -242,7 +242,7 @@ def write(sweep: Sweep, doc: dict, out: Path) -> None:
     s, u = doc["summary"], sweep.unit
     lines = [f"# Table {sweep.table}: critical {sweep.quantity} (thesis {sweep.table})", "",
              f"Scene `{sweep.scene}`, seed {doc['seed']}, commit {doc['commit']}, "
-             f"{'quick' if doc['quick'] else 'full'} mode{doc.get('learner', '')}. Predicted / actual, ours beside the thesis's; "
+             f"{'quick' if doc['quick'] else 'full'} mode{doc['learner']}. Predicted / actual, ours beside the thesis's; "
              f"'-': no critical value in {sweep.lo:g}-{sweep.hi:g} {u}.", "",
              "| orientation | " + " | ".join(f"{b}: ours | thesis" for b in sweep.behaviors) + " |",
              "|---|" + "---|---|" * len(sweep.behaviors)]

@@ -39,7 +39,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import commit, learner_note, learner_option, parser, train_model  # noqa: E402
+from _common import commit, learner_fields, learner_option, parser, train_model  # noqa: E402
 
 NAME = "fig_5_5_body"
 SCENE = "traverse-body"
@@ -165,7 +165,7 @@ def main() -> None:
     agreement = {m: round(float(np.mean([c["predicted"] == c["actual"] for c in grid if c["map"] == m])), 4)
                  for m in ("lateral", "vertical")}
     doc = {"name": NAME, "seed": args.seed, "commit": commit(), "quick": args.quick, "model": args.model,
-           "kernel": None if args.model else (args.kernel or "linear"), "learner": learner_note(args),
+           **learner_fields(args),
            "box": BOX, "step": step, "rows": rows, "agreement": agreement,
            "within_one_step": sum(r["error"] is not None and abs(r["error"]) <= step + 1e-9 for r in rows),
            "thesis": "predicted boundaries on the real ones (figure 5.5; no numbers given)", "maps": grid}
