@@ -522,6 +522,17 @@ class Model(LoadedModel):
         """The best of :meth:`plans` (``plan.found``, ``plan.steps``, ``plan.success_probability``)."""
         return self.plans(state, goal, **limits)[0]
 
+    def blind_probability(self, state: np.ndarray, goal, plan, *, rollouts: int = 200, seed: int = 0) -> float:
+        """P(``goal`` holds after some step of ``plan`` run blind from ``state``, with no
+        monitoring), by imagined worlds that draw each step's whole effect from one of the
+        nearest members (:func:`afford.plan.monitor.blind_probability`)."""
+        from afford.plan.monitor import blind_probability
+
+        goal = parse_goal(goal, self.schema)
+        state = np.asarray(state, dtype=float)
+        goal.check_objects(state.shape[0])
+        return blind_probability(self.forward(), state, goal, plan, rollouts=rollouts, seed=seed)
+
     def execute(self, world, goal, *, first=None, alternatives: int = 3, max_replans: int = 3,
                 method: str = "best-first", max_depth: int = 5, max_nodes: int = 20000, say=None):
         """Plan in ``world`` (see :func:`world`; ``first``: a plan already made there), act,

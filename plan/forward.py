@@ -505,25 +505,42 @@ class ForwardModel:
             return members.predict(self._member_input(self.behaviors[b], f, alpha), category)[1]
         return members.category_spread(category)
 
-    def draw_effect(self, f: np.ndarray, b: int, category: int, alpha: tuple, rng: np.random.Generator) -> np.ndarray:
-        """One effect of category ``category`` on ``f`` as a world might give it: the
-        predicted (mean) effect, with its geometry (where the object goes, what goals are
-        mostly about) taken from one of the nearest members' own effects (channels whose
-        best count was every member keep the mean: the members say nothing of this object
-        there), snapped so that
-        the object lands on a lattice of a quarter of each feature's goal tolerance (1.25 cm
-        at the table). Imagined worlds then share states, and their replans, where the
-        members' effects lie within that lattice; the drawn spread stays. Without member
-        effects: the prototype."""
+    def draw_effect(self, f: np.ndarray, b: int, category: int, alpha: tuple, rng: np.random.Generator,
+                    whole: bool = False) -> np.ndarray:
+        """One effect of category ``category`` on ``f`` as a world might give it.
+
+        By default (``whole=False``): the predicted (mean) effect, with its geometry (where
+        the object goes, what goals are mostly about) taken from one of the nearest members'
+        own effects (channels whose best count was every member keep the mean: the members
+        say nothing of this object there), snapped so that the object lands on a lattice of a
+        quarter of each feature's goal tolerance (1.25 cm at the table). Imagined worlds then
+        share states, and their replans, where the members' effects lie within that lattice;
+        the drawn spread stays.
+
+        ``whole=True``: the whole effect one member had, every channel, geometry snapped the
+        same way: one of the members nearest ``f`` (as many as its most local channel
+        averages; any member of the category where every channel takes them all). A plan run
+        blind (:func:`afford.plan.monitor.blind_probability`) is judged this way, since the
+        next step's predictor reads every channel: the mean of several members' shape changes
+        can be a shape none of them had (on the crane, the mean of a lying cylinder's
+        neighbours' moves shows a flat top that lift calls liftable), and P(next step | mean
+        state) is not the mean of P(next step | state).
+
+        Without member effects: the prototype."""
         mean = self.effect(f, b, category, alpha)
         members = self._members(b, category)
         if members is None:
             return mean
         x = self._member_input(self.behaviors[b], f, alpha)
+        r = int(rng.integers(1 << 30))  # one draw: the same neighbour rank for every channel
+        channels = np.asarray(self.schema.channels)
+        if whole:
+            local = [c for c in dict.fromkeys(channels) if members.k_.get(c, 0) > 0]
+            near = min(local, key=lambda c: members.k_[c]) if local else channels[0]
+            effects = members.effects(x, category, near)
+            return self._snap(f, effects[r % len(effects)].astype(float))
         out = mean.copy()
         cols = self.schema.geometry
-        channels = np.asarray(self.schema.channels)
-        r = int(rng.integers(1 << 30))  # one draw: the same neighbour rank for every channel
         for channel in dict.fromkeys(channels[cols]):
             if members.k_.get(channel, 0) == 0:
                 continue  # the prototype predicted this channel best: its members say nothing of this object

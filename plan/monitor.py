@@ -11,7 +11,8 @@ prediction would otherwise send it round in circles). The robot knows which obje
 holds (one a step raised) and replans with it.
 
 :func:`reach_probability` runs the same executor in worlds drawn from the model, to tell how
-likely a plan is to reach its goal when it is run this way; :func:`assess` stores that on
+likely a plan is to reach its goal when it is run this way (:func:`blind_probability`, when
+it is run blind); :func:`assess` stores that on
 the plan next to its open-loop probability, and :func:`rank_plans` orders the most probable
 plans by it. When the world says its arm did not start (the object lay beyond reach), the
 robot leaves that object alone where it lies.
@@ -31,7 +32,7 @@ from afford.plan.forward import SCENE
 from afford.plan.goals import Goal
 from afford.plan.search import UNREACHABLE, Plan, best_plans, phase, search, situation, unwatched
 
-__all__ = ["World", "Execution", "assess", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
+__all__ = ["World", "Execution", "assess", "blind_probability", "execute", "mismatch", "rank_plans", "reach_probability", "ranked_planner"]
 
 
 class World(Protocol):
@@ -192,8 +193,8 @@ class _Imagined:
     at the table many pushes of a discarded kind moved their objects as the kept kinds do.
     """
 
-    def __init__(self, model: ForwardModel, state: np.ndarray, rng: np.random.Generator):
-        self.model, self.state, self.rng = model, state.copy(), rng
+    def __init__(self, model: ForwardModel, state: np.ndarray, rng: np.random.Generator, whole: bool = False):
+        self.model, self.state, self.rng, self.whole = model, state.copy(), rng, whole
         self.fate: dict = {}
 
     def perceive(self) -> np.ndarray:
@@ -204,7 +205,8 @@ class _Imagined:
         category drawn from the model's distribution, the effect from those the category's
         members most like ``f`` had (:meth:`ForwardModel.draw_effect`). An unknown kind is
         category -1 with an effect a discarded member had (:meth:`ForwardModel.draw_unknown`),
-        or None (nothing happens) where there is none to draw."""
+        or None (nothing happens) where there is none to draw. ``whole``: every channel of
+        the effect is one member's (``draw_effect(whole=True)``), not only its geometry."""
         key = (f.tobytes(), b, alpha)
         if key not in self.fate:
             classes, proba = self.model.distribution(f, b, alpha)
@@ -212,7 +214,7 @@ class _Imagined:
             r = self.rng.random()
             if edges.size and r < edges[-1]:
                 c = int(classes[min(np.searchsorted(edges, r, side="right"), len(classes) - 1)])
-                self.fate[key] = (c, self.model.draw_effect(f, b, c, alpha, self.rng))
+                self.fate[key] = (c, self.model.draw_effect(f, b, c, alpha, self.rng, whole=self.whole))
             else:
                 effect = self.model.draw_unknown(f, b, alpha, self.rng)
                 self.fate[key] = None if effect is None else (-1, effect)
@@ -230,6 +232,41 @@ class _Imagined:
         if fate is not None and self.model.visible(self.state[target]):
             self.state = self.model.apply(self.state, target, b, fate[0], alpha_key, effects=fate[1])
         return self.perceive()
+
+
+def blind_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, rollouts: int = 200,
+                      seed: int = 0) -> float:
+    """P(the goal holds after some step when ``plan`` runs blind, with no monitoring), by the
+    model: the fraction of ``rollouts`` imagined worlds (:class:`_Imagined`) where it does.
+
+    Each step's category is drawn from the model's distribution and its effect is the whole
+    effect one of the nearest members had (:meth:`ForwardModel.draw_effect` with
+    ``whole=True``), every channel, so the next step is judged on a state some member
+    really reached. The open-loop walk (:func:`plan.search.success_probability`) judges it
+    on the members' mean state instead, which can be a state none of them reached: the
+    crane's planner, from its start percept, gave lying cylinders and spheres two-step
+    lift plans with a median open-loop probability of 0.7, none of which lifted anything.
+    Measured there (258 breadth-first plans on 1000 training episodes; 200 rollouts each),
+    the mean predicted success against the rate reached blind in PhysX: open-loop 0.81
+    against 0.66, blind draws of the geometry alone 0.76, of whole effects 0.69; Brier
+    scores 0.171, 0.155 and 0.134.
+
+    The same ``seed`` gives the same figure; its standard error is at most
+    ``0.5 / sqrt(rollouts)``."""
+    if goal.holds(start):
+        return 1.0
+    if not plan.found:
+        return 0.0
+    rng = np.random.default_rng(seed)
+    reached = 0
+    with unwatched():
+        for _ in range(rollouts):
+            world = _Imagined(model, start, rng, whole=True)
+            for step in plan.steps:
+                if goal.holds(world.act(step.behavior, step.obj, step.alpha)):
+                    reached += 1
+                    break
+    return reached / rollouts
 
 
 def reach_probability(model: ForwardModel, start: np.ndarray, goal: Goal, plan: Plan, *, max_replans: int = 3,

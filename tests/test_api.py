@@ -154,6 +154,22 @@ def test_the_plan_the_api_makes_is_the_plan_the_cli_makes(pipeline):
     assert round(plan.success_probability, 4) == out["plan"]["success_probability"]
 
 
+def test_a_plan_run_blind_is_judged_by_the_plan_module_and_a_bad_goal_is_one_sentence(pipeline):
+    from afford.plan.monitor import blind_probability
+
+    model = afford.load_model(str(pipeline / "model.afford"))
+    state = afford.world("table", seed=4, objects=1).perceive()
+    plan = model.plan(state, "*:visibility=0")
+    assert plan.found and plan.steps
+    p = model.blind_probability(state, "*:visibility=0", plan, rollouts=50, seed=2)
+    assert 0.0 <= p <= 1.0
+    assert p == blind_probability(model.forward(), state, afford.parse_goal("*:visibility=0", model.schema), plan,
+                                  rollouts=50, seed=2)
+    assert model.blind_probability(state, "0:visibility=1", plan) == 1.0  # the goal holds before any step
+    with pytest.raises(afford.AffordError, match="unknown feature 'no_such'"):
+        model.blind_probability(state, "0:no_such=1", plan)
+
+
 def test_version_and_light_import():
     proc = subprocess.run([sys.executable, "-m", "afford", "--version"], capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stdout.strip() == f"afford {afford.__version__}"

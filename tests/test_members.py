@@ -9,7 +9,7 @@ from afford.features import FeatureSchema
 from afford.learn.members import MemberEffects
 from afford.plan.forward import BehaviorModel, ForwardModel
 from afford.plan.goals import parse_goal
-from afford.plan.monitor import reach_probability
+from afford.plan.monitor import blind_probability, reach_probability
 from afford.plan.search import best_first
 
 
@@ -307,3 +307,46 @@ def test_the_planner_answers_the_same_with_every_shortcut_as_without():
     assert quiet.path_probability == plans[0].path_probability and quiet.success_probability == 0.0
     p = [reach_probability(fm, start, goal, plan, rollouts=60, seed=3) for fm, plan in zip((fast, slow), plans)]
     assert p[0] == p[1] and 0.0 < p[0] < 1.0
+
+
+class _LiftableNearZero:
+    """Lift (category 0: the object rises) is likely only where the shape feature ``s`` lies
+    within 1 of zero, as the crane's lift reads a flat top in the normal histograms."""
+
+    classes_ = np.array([0, 1])
+
+    def predict_proba(self, X):
+        p = np.where(np.abs(np.asarray(X)[:, 1]) < 1.0, 0.95, 0.02)
+        return np.column_stack([p, 1 - p])
+
+
+def _move_then_lift(spread: float, rng) -> tuple[ForwardModel, FeatureSchema]:
+    """A move that changes ``s`` by -2, give or take ``spread`` (a coin nothing in the entity
+    foretells), and a lift that raises ``x`` by 1 where ``s`` is near zero."""
+    schema = FeatureSchema(("x", "s"), ("position", "shape"))
+    X = rng.uniform(0, 1, (400, 2))
+    E = np.column_stack([rng.normal(0, 0.002, 400), -2 + spread * rng.choice([-1.0, 1.0], 400)])
+    members = MemberEffects(["position", "shape"], ["position", "shape"], [0.05, 0.1]).fit(X, E, np.zeros(400, int))
+    move = BehaviorModel("move", _Sure(), np.array([0, 1]), np.array([E.mean(axis=0), [0.0, 0.0]]), members=members)
+    lift = BehaviorModel("lift", _LiftableNearZero(), np.array([0, 1]), np.array([[1.0, 0.0], [0.0, 0.0]]))
+    return ForwardModel([move, lift], schema, effects="members"), schema
+
+
+def test_a_plan_run_blind_is_judged_on_states_members_reached_not_on_their_mean():
+    """Every move leaves ``s`` at -1.5 or +1.5, where lift fails; their mean, 0, is where it
+    works. The open-loop walk judges lift on the mean state and expects the plan to work;
+    blind rollouts draw whole member effects and expect it to fail, as it would. Where the
+    members agree, the two figures agree."""
+    start = np.array([[0.0, 2.0]])
+    fm, schema = _move_then_lift(1.5, np.random.default_rng(11))
+    goal = parse_goal(["0:x>0.5"], schema)
+    plan = best_first(fm, start, goal, max_depth=2)
+    assert [s.behavior for s in plan.steps] == ["move", "lift"]
+    assert plan.success_probability > 0.85
+    assert blind_probability(fm, start, goal, plan, rollouts=300, seed=0) < 0.1
+    assert blind_probability(fm, start, goal, plan, rollouts=300, seed=0) == \
+        blind_probability(fm, start, goal, plan, rollouts=300, seed=0)  # the seed fixes it
+    sure, _ = _move_then_lift(0.0, np.random.default_rng(11))
+    sure_plan = best_first(sure, start, goal, max_depth=2)
+    p = blind_probability(sure, start, goal, sure_plan, rollouts=300, seed=0)
+    assert p == pytest.approx(sure_plan.success_probability, abs=0.05)

@@ -161,6 +161,11 @@ def test_crane_figures_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     cells = [r for r in doc["rows"] if r["figure"] == "7.1" and r.get("length")]
     assert cells and all(r["reached"] <= r["found"] for r in cells)
     assert not any(r["reached"] for r in cells if r["shape"] in ("sphere", "lying-cylinder"))
+    # each cell's two predictions are probabilities, and the summary's are the cells' means weighted by plans
+    assert all(0 <= r["mean_predicted"] <= 1 and 0 <= r["mean_blind"] <= 1 for r in cells)
+    found = sum(r["found"] for r in cells)
+    assert doc["summary"]["mean_blind"] == pytest.approx(sum(r["mean_blind"] * r["found"] for r in cells) / found, abs=1e-3)
+    assert 0 <= doc["summary"]["brier_blind"] <= 1
     assert doc["thesis"]["table_7_1"]["2"][1] == [538, 605]
     assert "Table 7.1" in (tmp_path / "table_7_1_crane.md").read_text()
     assert (tmp_path / "table_7_1_crane.png").read_bytes()[:4] == b"\x89PNG"
