@@ -65,6 +65,10 @@ Layout = Annotated[Optional[str], typer.Option("--layout", help="A TOML layout f
 MaxDepth = Annotated[int, typer.Option("--max-depth", min=1, max=8, help="Longest plan.")]
 MaxNodes = Annotated[int, typer.Option("--max-nodes", min=1, help="Most search nodes to expand.")]
 MaxReplans = Annotated[int, typer.Option("--max-replans", min=0, max=20, help="Most replans after surprises.")]
+BlindRollouts = Annotated[int, typer.Option(
+    "--blind-rollouts", min=0, max=100_000,
+    help="Also judge the plan run blind in this many imagined worlds, each step's whole effect drawn from one of "
+         "the nearest members (0: not).")]
 
 
 def check_scene_source(layout: Optional[str], seed: Optional[int], **drawn) -> None:

@@ -40,7 +40,7 @@ def progress_bars(output, after: float | None = None):
 
 
 def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, execute: bool, max_replans: int,
-              alternatives: int = 3, say=None, plot: str | None = None, progress=None) -> dict:
+              alternatives: int = 3, say=None, plot: str | None = None, progress=None, blind_rollouts: int = 0) -> dict:
     """Plan in one scene (and execute with monitoring); the result as plain data.
 
     With ``alternatives`` > 1 the most probable plans are ranked by their success
@@ -55,8 +55,11 @@ def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, e
     ``assess_seconds`` its two parts (the search for the candidates; their imagined runs,
     which give each one's success probability with monitoring, and are most of it); each
     plan's own ``seconds`` is the search up to it. ``execution_seconds``: running it, with
-    every replan's search and assessment.
+    every replan's search and assessment. ``blind_rollouts``: also the plan's
+    ``blind_probability`` (:func:`afford.plan.monitor.blind_probability`, seeded by the scene's
+    seed) from that many imagined blind runs.
     """
+    from afford.plan.monitor import blind_probability
     from afford.plan.search import watching
 
     world = open_world(scene, specs, seed)
@@ -78,6 +81,10 @@ def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, e
            "assess_seconds": round(assessing, 4)}
     if alternatives > 1:
         out["alternatives"] = [p.to_json() for p in ranked[1:]]
+    if blind_rollouts and first.found:  # before execution: the world is still at the start
+        out["plan"]["blind_probability"] = round(blind_probability(model.forward(), start, goal, first,
+                                                                   rollouts=blind_rollouts, seed=seed), 4)
+        out["plan"]["blind_rollouts"] = blind_rollouts
     if execute and first.found:
         t0 = time.perf_counter()
         with watched():

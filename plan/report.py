@@ -10,7 +10,7 @@ __all__ = ["summarise"]
 def summarise(entries: list[dict], executed: bool) -> dict:
     """Found, reached and mean probabilities over the ``plan_once`` results of many scenes."""
     by_length: dict[str, dict] = {}
-    probs, blind, first_ok = [], [], []
+    probs, blind, imagined, first_ok = [], [], [], []
     for e in entries:
         p = e["plan"]
         if not p["found"]:
@@ -20,6 +20,8 @@ def summarise(entries: list[dict], executed: bool) -> dict:
         slot["found"] += 1
         probs.append(p["success_probability"])
         blind.append(p["open_loop_probability"])
+        if "blind_probability" in p:
+            imagined.append(p["blind_probability"])
         if executed:
             slot["reached"] += int(e.get("reached", False))
             first_ok.append(bool(e.get("first_plan_worked", False)))
@@ -28,6 +30,7 @@ def summarise(entries: list[dict], executed: bool) -> dict:
     out = {"episodes": len(entries), "skipped": len(entries) - len(planned), "found": found, "by_length": dict(sorted(by_length.items(), key=lambda kv: int(kv[0]))),
            "mean_success_probability": round(float(np.mean(probs)), 4) if probs else None,
            "mean_open_loop_probability": round(float(np.mean(blind)), 4) if blind else None,
+           "mean_blind_probability": round(float(np.mean(imagined)), 4) if imagined else None,
            "mean_seconds": round(float(np.mean([e["plan"]["seconds"] for e in planned] or [0.0])), 4),
            "mean_expanded": round(float(np.mean([e["plan"]["expanded"] for e in planned] or [0.0])), 1),
            # the search and the candidates' assessment (a caller that times the search alone: its time)

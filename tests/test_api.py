@@ -170,6 +170,25 @@ def test_a_plan_run_blind_is_judged_by_the_plan_module_and_a_bad_goal_is_one_sen
         model.blind_probability(state, "0:no_such=1", plan)
 
 
+def test_plan_blind_rollouts_reports_the_apis_blind_probability_and_its_mean_over_scenes(pipeline):
+    model_path = str(pipeline / "model.afford")
+    args = ["plan", model_path, "--seed", "4", "--objects", "1", "--goal", "*:visibility=0", "--json"]
+    out = json.loads(runner.invoke(app, args + ["--blind-rollouts", "50"]).stdout)
+    assert "blind_probability" not in json.loads(runner.invoke(app, args).stdout)["plan"]  # off unless asked
+    model = afford.load_model(model_path)
+    state = afford.world("table", seed=4, objects=1).perceive()
+    plan = model.plan(state, "*:visibility=0")
+    assert out["plan"]["blind_probability"] == round(model.blind_probability(state, "*:visibility=0", plan,
+                                                                             rollouts=50, seed=4), 4)
+    assert out["blind_probability"] == out["plan"]["blind_probability"] and out["plan"]["blind_rollouts"] == 50
+    many = json.loads(runner.invoke(app, ["plan", model_path, "--seed", "4", "--objects", "1", "--episodes", "3",
+                                          "--goal", "*:visibility=0", "--blind-rollouts", "20", "--json"]).stdout)
+    values = [r["plan"]["blind_probability"] for r in many["runs"] if r["plan"]["found"]]
+    assert values and many["mean_blind_probability"] == pytest.approx(np.mean(values), abs=1e-4)
+    bad = runner.invoke(app, args + ["--blind-rollouts", "-1"])
+    assert bad.exit_code == 2
+
+
 def test_version_and_light_import():
     proc = subprocess.run([sys.executable, "-m", "afford", "--version"], capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stdout.strip() == f"afford {afford.__version__}"

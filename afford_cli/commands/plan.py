@@ -13,7 +13,7 @@ from afford.errors import AffordError
 from afford.features.errors import DataError
 from afford.learning import load_model
 from afford.options import (
-    AlphaRule, AlphaRuleOpt, EffectModel, Effects,
+    AlphaRule, AlphaRuleOpt, BlindRollouts, EffectModel, Effects,
     Alternatives, Json, Layout, MaxDepth, MaxNodes, MaxReplans, ModelScene, Objects, SceneSeed, check_scene_source,
 )
 from afford.output import Output
@@ -51,7 +51,9 @@ def render_plan(console, entry: dict, goal_text: list[str]) -> None:
         effort = f"{p['expanded']} nodes expanded, {p['seconds'] * 1000:.0f} ms searching"
     console.print(f"plan: {p['length']} step{'s' if p['length'] != 1 else ''} ({effort}); success probability "
                   f"{p['success_probability']:.2f} with monitoring and up to {p['replans_assumed']} replans, "
-                  f"{p['open_loop_probability']:.2f} run blind")
+                  f"{p['open_loop_probability']:.2f} run blind"
+                  + (f" ({p['blind_probability']:.2f} in {p['blind_rollouts']} imagined blind runs)"
+                     if "blind_probability" in p else ""))
     table = Table(box=box.SIMPLE_HEAD)
     for col in ("step", "behaviour", "object", "alpha", "expected category", "p"):
         table.add_column(col)
@@ -91,6 +93,7 @@ def plan(
     method: Annotated[SearchMethod, typer.Option("--search", help="Most probable plan (best-first) or the thesis's breadth-first chaining.")] = SearchMethod.best_first,
     execute: Annotated[bool, typer.Option("--execute", help="Run the plan in the simulator, monitor it and replan on surprises.")] = False,
     max_replans: MaxReplans = 3,
+    blind_rollouts: BlindRollouts = 0,
     episodes: Annotated[int, typer.Option("--episodes", min=1, help="Plan in this many random scenes (seeds S, S+1, ...) and report rates.")] = 1,
     reachable: Annotated[bool, typer.Option("--reachable", help="Draw only objects within the arm's reach.")] = False,
     button: Annotated[bool, typer.Option("--button", help="Add the fixed flat button of thesis 7.6.5 to a drawn scene (crane-lift).")] = False,
@@ -120,13 +123,15 @@ def plan(
     if episodes == 1:
         sc, specs = scene_layout(scene, seed, layout, objects=objects, reachable=reachable, button=button)
         entries.append(plan_once(loaded, sc, specs, base, g, method.value, limits, execute, max_replans, alternatives,
-                                 say=out.info if execute else None, plot=plot, progress=progress_bars(out)))
+                                 say=out.info if execute else None, plot=plot, progress=progress_bars(out),
+                                 blind_rollouts=blind_rollouts))
     else:
         with out.progress("planning episodes", episodes) as update:
             for e in range(episodes):
                 sc, specs = scene_layout(scene, base + e, None, objects=objects, reachable=reachable, button=button)
                 try:
-                    entries.append(plan_once(loaded, sc, specs, base + e, g, method.value, limits, execute, max_replans, alternatives))
+                    entries.append(plan_once(loaded, sc, specs, base + e, g, method.value, limits, execute, max_replans,
+                                             alternatives, blind_rollouts=blind_rollouts))
                 except (AffordError, DataError) as exc:  # e.g. an object hidden behind another
                     entries.append({"seed": base + e, "skipped": str(exc),
                                     "plan": {"found": False, "seconds": 0.0, "expanded": 0, "length": 0}})
@@ -153,6 +158,7 @@ def single_plan(entry: dict, execute: bool) -> dict:
     p = entry["plan"]
     out = {"found": bool(p["found"]), "success_probability": p["success_probability"],
            "open_loop_probability": p["open_loop_probability"],
+           **({"blind_probability": p["blind_probability"]} if "blind_probability" in p else {}),
            "reached": False if execute else None, "replans": 0 if execute else None}
     if execute:
         out["first_plan_worked"] = False
@@ -176,6 +182,8 @@ def render_summary(console, result: dict) -> None:
         reached = (f" (goal reached in {result['reached']} of {result['found']})" if "reached" in result else "")
         console.print(f"mean predicted success probability with monitoring {result['mean_success_probability']:.2f}{reached}; "
                       f"run blind {result['mean_open_loop_probability']:.2f}"
+                      + (f" ({result['mean_blind_probability']:.2f} in imagined blind runs)"
+                         if result.get("mean_blind_probability") is not None else "")
                       + (f" (first plans that worked without replanning: {result['first_plan_worked']} of {result['found']})"
                          if "first_plan_worked" in result else ""))
     console.print(f"mean search: {result['mean_expanded']:.0f} nodes, {1000 * result['mean_seconds']:.0f} ms; "
