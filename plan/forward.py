@@ -527,19 +527,18 @@ class ForwardModel:
         state) is not the mean of P(next step | state).
 
         Without member effects: the prototype."""
-        mean = self.effect(f, b, category, alpha)
         members = self._members(b, category)
         if members is None:
-            return mean
+            return self.effect(f, b, category, alpha)
         x = self._member_input(self.behaviors[b], f, alpha)
         r = int(rng.integers(1 << 30))  # one draw: the same neighbour rank for every channel
         channels = np.asarray(self.schema.channels)
-        if whole:
+        if whole:  # no mean needed (nor cached: a blind rollout meets a new entity at every draw)
             local = [c for c in dict.fromkeys(channels) if members.k_.get(c, 0) > 0]
             near = min(local, key=lambda c: members.k_[c]) if local else channels[0]
             effects = members.effects(x, category, near)
             return self._snap(f, effects[r % len(effects)].astype(float))
-        out = mean.copy()
+        out = self.effect(f, b, category, alpha).copy()
         cols = self.schema.geometry
         for channel in dict.fromkeys(channels[cols]):
             if members.k_.get(channel, 0) == 0:
