@@ -144,7 +144,9 @@ def _cpu_seconds(pid: int) -> float:
 def _explore_until_workers(tmp_path):
     import time
 
-    proc = subprocess.Popen([*AFFORD, "explore", "--episodes", "400", "--workers", "2", "-o", "x.afford"],
+    # 4000 episodes: on a fast machine 400 took 5 s, so the signal could land as the run
+    # ended (the tests kill it long before it ends)
+    proc = subprocess.Popen([*AFFORD, "explore", "--episodes", "4000", "--workers", "2", "-o", "x.afford"],
                             cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.time() + 90
     while time.time() < deadline:
