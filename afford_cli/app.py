@@ -45,25 +45,51 @@ def _options(
     """Learn what objects afford by playing with them in simulation (after Ugur's thesis)."""
 
 
+def _interruption(exc: BaseException | None) -> KeyboardInterrupt | None:
+    """The Ctrl-C or SIGTERM that caused ``exc``, if one did. An interruption that lands inside an import of a
+    compiled module comes out as ``ImportError: initialization failed`` caused by it (seen
+    with open3d), and one inside a library's clean-up may come out as another error."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+#: Set once an interruption has been reported, so that :func:`main` does not report it twice.
+_reported: list[bool] = [False]
+
+
+def _interrupted(exc: BaseException) -> typer.Exit:
+    message = str(exc) if isinstance(exc, Interrupted) else "interrupted; the output being written was discarded"
+    sys.stderr.write(f"\nerror: {message}\n")
+    _reported[0] = True
+    return typer.Exit(130)
+
+
 def _guarded(command: Callable) -> Callable:
-    """Known failures become ``error: <one sentence>`` on stderr and exit code 1."""
+    """Known failures become ``error: <one sentence>`` on stderr and exit code 1; an
+    interruption (Ctrl-C, SIGTERM), and any error it caused, exits with 130."""
 
     @functools.wraps(command)
     def run(*args, **kwargs):
         try:
             return command(*args, **kwargs)
-        except (AffordError, DataError, OSError) as exc:
-            # afford's own errors (and the operating system's) are the user's to fix; anything
-            # else is a bug in afford and surfaces as one
+        except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: outputs are written whole or not at all
+            raise _interrupted(exc) from None
+        except Exception as exc:
+            cause = _interruption(exc)
+            if cause is not None:
+                raise _interrupted(cause) from None
+            if not isinstance(exc, (AffordError, DataError, OSError)):
+                raise  # anything else is a bug in afford and surfaces as one
+            # afford's own errors (and the operating system's) are the user's to fix
             if os.environ.get("AFFORD_DEBUG") == "1":
                 raise
-            message = str(exc)
-            sys.stderr.write(f"error: {message}\n")
+            sys.stderr.write(f"error: {exc}\n")
             raise typer.Exit(1) from None
-        except KeyboardInterrupt as exc:  # Ctrl-C or SIGTERM: outputs are written whole or not at all
-            message = str(exc) if isinstance(exc, Interrupted) else "interrupted; the output being written was discarded"
-            sys.stderr.write(f"\nerror: {message}\n")
-            raise typer.Exit(130) from None
 
     return run
 
@@ -76,8 +102,28 @@ for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
     app.command(_name)(_guarded(_command))
 
 
-def _terminate(signum, frame):  # noqa: ARG001
-    raise KeyboardInterrupt  # SIGTERM is an interruption like Ctrl-C: temp files go, exit 130
+def _importing(frame) -> bool:
+    """Is ``frame`` (where a signal landed) inside an import?"""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _terminate(signum, frame):
+    """Ctrl-C and SIGTERM are one interruption: temp files go, exit 130. One that lands inside
+    an import waits until the import is done (50 ms on): raised inside a compiled module's
+    initialisation (open3d's, seen), it broke the interpreter, which then ended with an
+    ImportError's traceback, with exit code 1, or killed by SIGINT."""
+    if _importing(frame):
+        import threading
+
+        retry = threading.Timer(0.05, os.kill, (os.getpid(), signum))
+        retry.daemon = True
+        retry.start()
+        return
+    raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -85,11 +131,17 @@ def main(argv: list[str] | None = None) -> None:
     import signal
 
     signal.signal(signal.SIGTERM, _terminate)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not where the shell made it ignored
+        signal.signal(signal.SIGINT, _terminate)
     try:
         app(args=argv)
     except KeyboardInterrupt:
         sys.stderr.write("error: interrupted\n")
         sys.exit(130)
+    except SystemExit as exc:
+        if exc.code == 130 and not _reported[0]:  # interrupted outside a command (typer's own 130)
+            sys.stderr.write("\nerror: interrupted\n")
+        raise
     except BrokenPipeError:  # a pipeline reader went away: not our error to report
         sys.exit(1)
     finally:

@@ -187,6 +187,84 @@ def test_sigterm_is_an_interruption_and_leaves_no_temp_file(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] in ([], ["x.afford.partial"])
 
 
+def _raise_from_interruption(kind: str):
+    """A command whose work an interruption broke: the error a library made of it."""
+    from afford.errors import Interrupted
+
+    try:
+        raise Interrupted("interrupted; 3 finished episodes are kept") if kind == "kept" else KeyboardInterrupt
+    except KeyboardInterrupt as exc:
+        if kind == "context":
+            raise OSError("handle is closed")  # raised while handling it: its __context__
+        raise ImportError("initialization failed") from exc  # what open3d's import makes of it
+
+
+@pytest.mark.parametrize("kind", ["cause", "context", "kept"])
+def test_an_error_an_interruption_caused_exits_130_with_one_sentence(kind, capsys):
+    """A SIGTERM that landed while open3d was being imported once ended in an ImportError's
+    traceback and exit 1; an error whose cause or context is an interruption is the interruption."""
+    import typer
+
+    from afford.app import _guarded
+
+    with pytest.raises(typer.Exit) as exit_:
+        _guarded(lambda: _raise_from_interruption(kind))()
+    err = capsys.readouterr().err
+    assert exit_.value.exit_code == 130
+    assert err.strip() == ("error: interrupted; 3 finished episodes are kept" if kind == "kept"
+                           else "error: interrupted; the output being written was discarded")
+
+
+def test_a_sigterm_inside_an_import_waits_for_the_import(tmp_path):
+    """A signal that lands while a module is being imported is raised once the import is done
+    (inside a compiled module's initialisation it broke the interpreter)."""
+    (tmp_path / "slow_module.py").write_text(
+        "import os, signal, time\nos.kill(os.getpid(), signal.SIGTERM)\ntime.sleep(0.3)\nDONE = True\n")
+    script = ("import signal, sys, time\nfrom afford.app import _terminate\nsignal.signal(signal.SIGTERM, _terminate)\n"
+              "try:\n    import slow_module\n    print('imported', slow_module.DONE, flush=True)\n    time.sleep(10)\n"
+              "    print('never interrupted')\nexcept KeyboardInterrupt:\n    print('interrupted', 'slow_module' in sys.modules)\n")
+    proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])})
+    assert proc.stdout.split() == ["imported", "True", "interrupted", "True"], proc.stderr[-500:]
+
+
+def test_an_error_with_no_interruption_behind_it_stays_an_error(capsys):
+    import typer
+
+    from afford.app import _guarded
+
+    def command():
+        try:
+            raise ValueError("parsing")
+        except ValueError as exc:
+            raise OSError("disk full") from exc
+
+    with pytest.raises(typer.Exit) as exit_:
+        _guarded(command)()
+    assert exit_.value.exit_code == 1 and capsys.readouterr().err == "error: disk full\n"
+
+
+def test_an_interruption_outside_any_command_still_says_so(monkeypatch, capsys):
+    """Typer turns a Ctrl-C during its own parsing into exit 130 with no word; main adds one."""
+    import afford.app as cli
+
+    def interrupted_while_parsing(args=None):
+        raise SystemExit(130)
+
+    import signal
+
+    monkeypatch.setattr(cli, "app", interrupted_while_parsing)
+    monkeypatch.setattr(cli, "_reported", [False])
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with pytest.raises(SystemExit) as exit_:
+            cli.main([])
+    finally:  # main ignores both signals as it ends; this process goes on
+        for s, handler in handlers.items():
+            signal.signal(s, handler)
+    assert exit_.value.code == 130 and capsys.readouterr().err.strip() == "error: interrupted"
+
+
 # -- forged artefacts: checksums and seal recomputed, as a forger who knows the format would --
 
 def forge(src: Path, dst: Path, members: dict | None = None, manifest=None, seal: bool = True) -> Path:
