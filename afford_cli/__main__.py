@@ -1,4 +1,4 @@
 """The afford command line (python -m afford)."""
-from afford.app import main
+from afford.interrupt import main
 
 main()

@@ -18,6 +18,7 @@ from afford.commands import (
     select_features, train,
 )
 from afford.errors import AffordError, Interrupted
+from afford.interrupt import install
 from afford.features.errors import DataError
 
 app = typer.Typer(
@@ -102,37 +103,12 @@ for _name, _command in (("scenes", scenes.scenes), ("explore", explore.explore),
     app.command(_name)(_guarded(_command))
 
 
-def _importing(frame) -> bool:
-    """Is ``frame`` (where a signal landed) inside an import?"""
-    while frame is not None:
-        if frame.f_code.co_filename.startswith("<frozen importlib"):
-            return True
-        frame = frame.f_back
-    return False
-
-
-def _terminate(signum, frame):
-    """Ctrl-C and SIGTERM are one interruption: temp files go, exit 130. One that lands inside
-    an import waits until the import is done (50 ms on): raised inside a compiled module's
-    initialisation (open3d's, seen), it broke the interpreter, which then ended with an
-    ImportError's traceback, with exit code 1, or killed by SIGINT."""
-    if _importing(frame):
-        import threading
-
-        retry = threading.Timer(0.05, os.kill, (os.getpid(), signum))
-        retry.daemon = True
-        retry.start()
-        return
-    raise KeyboardInterrupt
-
-
 def main(argv: list[str] | None = None) -> None:
-    """Console entry point."""
+    """The command line (the console entry point, :func:`afford.interrupt.main`, installs the
+    interruption handlers before it imports this module, then calls this)."""
     import signal
 
-    signal.signal(signal.SIGTERM, _terminate)
-    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not where the shell made it ignored
-        signal.signal(signal.SIGINT, _terminate)
+    install()  # again, for a caller of this function: the console entry point did it first
     try:
         app(args=argv)
     except KeyboardInterrupt:

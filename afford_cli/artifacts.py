@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from afford.errors import AffordError
+from afford.interrupt import uninterrupted
 
 __all__ = [
     "SCHEMA_VERSION", "MIN_SCHEMA_VERSION", "Artifact", "write_artifact", "read_artifact",
@@ -340,9 +341,10 @@ def _target(path: str) -> tuple[str, Path]:
     if mode is not None and not os.access(real, os.W_OK):
         raise AffordError(f"cannot write {path}: permission denied")
     try:  # the only sure test of "can a new file go here" (/proc, /sys and read-only mounts say yes to access())
-        fd, probe = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".probe", dir=parent)
-        os.close(fd)
-        os.unlink(probe)
+        with uninterrupted():  # an interruption between making the probe and removing it left it behind
+            fd, probe = tempfile.mkstemp(prefix=f".{real.name}.", suffix=".probe", dir=parent)
+            os.close(fd)
+            os.unlink(probe)
     except OSError as exc:
         reason = exc.strerror.lower() if exc.strerror else "it takes no new file"
         raise AffordError(f"cannot write {path}: {parent} refuses new files ({reason})") from None
@@ -428,10 +430,12 @@ def write_artifact(path: str, data: bytes) -> None:
         except OSError as exc:
             raise AffordError(f"cannot write {path}: {exc.strerror.lower() if exc.strerror else exc}") from None
         return
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    umask = os.umask(0)
-    os.umask(umask)
+    tmp = None
     try:
+        with uninterrupted():  # the temporary file exists only once its clean-up below is armed
+            fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+            umask = os.umask(0)
+            os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a saved artefact gets the usual mode
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
@@ -439,10 +443,11 @@ def write_artifact(path: str, data: bytes) -> None:
             os.fsync(fh.fileno())
         os.replace(tmp, target)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except FileNotFoundError:
+                pass
         raise
 
 

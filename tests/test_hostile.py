@@ -220,12 +220,47 @@ def test_a_sigterm_inside_an_import_waits_for_the_import(tmp_path):
     (inside a compiled module's initialisation it broke the interpreter)."""
     (tmp_path / "slow_module.py").write_text(
         "import os, signal, time\nos.kill(os.getpid(), signal.SIGTERM)\ntime.sleep(0.3)\nDONE = True\n")
-    script = ("import signal, sys, time\nfrom afford.app import _terminate\nsignal.signal(signal.SIGTERM, _terminate)\n"
+    script = ("import signal, sys, time\nfrom afford.interrupt import terminate\nsignal.signal(signal.SIGTERM, terminate)\n"
               "try:\n    import slow_module\n    print('imported', slow_module.DONE, flush=True)\n    time.sleep(10)\n"
               "    print('never interrupted')\nexcept KeyboardInterrupt:\n    print('interrupted', 'slow_module' in sys.modules)\n")
     proc = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=60,
                           env={**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), *sys.path])})
     assert proc.stdout.split() == ["imported", "True", "interrupted", "True"], proc.stderr[-500:]
+
+
+def test_the_entry_point_turns_an_interruption_before_any_command_into_130(monkeypatch, capsys):
+    """The console entry point installs the handlers, then imports the commands: an
+    interruption that lands there (or as a command ends) is exit 130 with one sentence, not a
+    traceback nor death by the signal."""
+    import signal
+
+    import afford.app as cli
+    from afford import interrupt
+
+    def interrupted(argv=None):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "main", interrupted)
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        with pytest.raises(SystemExit) as exit_:
+            interrupt.main([])
+        assert signal.getsignal(signal.SIGTERM) is interrupt.terminate
+    finally:
+        for s, handler in handlers.items():
+            signal.signal(s, handler)
+    assert exit_.value.code == 130 and capsys.readouterr().err.strip() == "error: interrupted"
+
+
+def test_an_interruption_waits_for_steps_that_must_all_happen():
+    """Making and removing the output's probe file is one step: a SIGTERM between the two left
+    the probe behind. Held, the signal is delivered once the step is done."""
+    script = ("import os, signal, time\nfrom afford.interrupt import terminate, uninterrupted\n"
+              "signal.signal(signal.SIGTERM, terminate)\ndone = []\ntry:\n    with uninterrupted():\n"
+              "        os.kill(os.getpid(), signal.SIGTERM)\n        time.sleep(0.2)\n        done.append(1)\n"
+              "    time.sleep(10)\n    print('never interrupted')\nexcept KeyboardInterrupt:\n    print('interrupted after', len(done))\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert proc.stdout.split() == ["interrupted", "after", "1"], proc.stderr[-500:]
 
 
 def test_an_error_with_no_interruption_behind_it_stays_an_error(capsys):
