@@ -196,6 +196,11 @@ def test_grasp_tables_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     # the box is lifted from some sides and angles and not from others (PhysX's doing)
     assert 0 < sum(r["lifted"] for r in cells) < len(cells)
     assert 0.0 <= doc["summary"]["map_agreement"] <= 1.0
+    cells = [r for r in doc["rows"] if r["figure"] == "9.8"]
+    lifted = [r["real"] == r["lift_category"] for r in cells]
+    assert doc["summary"]["map_never_lifted_agreement"] == pytest.approx(1 - np.mean(lifted))
+    # a cell whose category is right is right on lifted-or-not too
+    assert doc["summary"]["map_agreement"] <= doc["summary"]["map_lift_agreement"] <= 1
     assert "Table 9.1" in (tmp_path / "tables_9_1_9_2_grasp.md").read_text()
     assert (tmp_path / "tables_9_1_9_2_grasp.png").read_bytes()[:4] == b"\x89PNG"
 
