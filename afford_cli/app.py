@@ -18,8 +18,8 @@ from afford.commands import (
     select_features, train,
 )
 from afford.errors import AffordError, Interrupted
-from afford.interrupt import install
 from afford.features.errors import DataError
+from afford.interrupt import install
 
 app = typer.Typer(
     name="afford",
@@ -47,9 +47,10 @@ def _options(
 
 
 def _interruption(exc: BaseException | None) -> KeyboardInterrupt | None:
-    """The Ctrl-C or SIGTERM that caused ``exc``, if one did. An interruption that lands inside an import of a
-    compiled module comes out as ``ImportError: initialization failed`` caused by it (seen
-    with open3d), and one inside a library's clean-up may come out as another error."""
+    """The Ctrl-C or SIGTERM that caused ``exc``, if one did. An interruption that lands
+    inside an import of a compiled module comes out as ``ImportError: initialization
+    failed`` caused by it (seen with open3d), and one inside a library's clean-up may come
+    out as another error."""
     seen = set()
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
