@@ -56,10 +56,9 @@ def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, e
     which give each one's success probability with monitoring, and are most of it); each
     plan's own ``seconds`` is the search up to it. ``execution_seconds``: running it, with
     every replan's search and assessment. ``blind_rollouts``: also the plan's
-    ``blind_probability`` (:func:`afford.plan.monitor.blind_probability`, seeded by the scene's
+    ``blind_probability`` (:meth:`afford.api.Model.blind_probability`, seeded by the scene's
     seed) from that many imagined blind runs.
     """
-    from afford.plan.monitor import blind_probability
     from afford.plan.search import watching
 
     world = open_world(scene, specs, seed)
@@ -82,8 +81,8 @@ def plan_once(model, scene, specs, seed: int, goal, method: str, limits: dict, e
     if alternatives > 1:
         out["alternatives"] = [p.to_json() for p in ranked[1:]]
     if blind_rollouts and first.found:  # before execution: the world is still at the start
-        out["plan"]["blind_probability"] = round(blind_probability(model.forward(), start, goal, first,
-                                                                   rollouts=blind_rollouts, seed=seed), 4)
+        out["plan"]["blind_probability"] = round(model.blind_probability(start, goal, first, rollouts=blind_rollouts,
+                                                                         seed=seed), 4)
         out["plan"]["blind_rollouts"] = blind_rollouts
     if execute and first.found:
         t0 = time.perf_counter()

@@ -180,7 +180,6 @@ def _plan_and_run(model, seed: int) -> dict | None:
     """Table 7.1 at placement ``seed``: the shortest lift plan, run blind in PhysX (None:
     nothing in view; no ``length``: no plan)."""
     import afford
-    from afford.plan.monitor import blind_probability
     from afford.plan.search import breadth_first
 
     sim = afford.world(SCENE, seed=seed)
@@ -192,7 +191,7 @@ def _plan_and_run(model, seed: int) -> dict | None:
     plan = breadth_first(model.forward(), start, goal, max_depth=4)
     if not plan.found or not plan.steps:
         return {"seed": seed, "shape": shape}
-    blind = blind_probability(model.forward(), start, goal, plan, rollouts=BLIND_ROLLOUTS, seed=seed)
+    blind = model.blind_probability(start, goal, plan, rollouts=BLIND_ROLLOUTS, seed=seed)
     for s in plan.steps:
         sim.act(s.behavior, s.obj)
     return {"seed": seed, "shape": shape, "length": len(plan.steps), "reached": _lifted(sim),
