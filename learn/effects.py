@@ -87,6 +87,41 @@ def _order_by_count(labels: np.ndarray, centers: np.ndarray) -> np.ndarray:
     return new_id
 
 
+def _merge_rare(Z: np.ndarray, labels: np.ndarray, centers: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """Join clusters of fewer than ``floor`` members whose nearest cluster is also that small.
+
+    X-means may split a rare effect into parts that are each too small to keep (the lifts
+    of a grasp into "lifted and moved left" and "lifted and moved right"); frequency
+    pruning would then drop the whole effect. Two rare clusters nearer to each other than
+    to any other cluster are one rare kind at a coarser grain, so the nearest such pair is
+    merged (its centre the mean of its members) until no rare cluster has a rare nearest
+    neighbour. A rare cluster nearest a common one is left alone (pruning decides it).
+    Returns compacted ``(labels, centers)``.
+    """
+    labels, centers = labels.copy(), centers.copy()
+    alive = np.ones(centers.shape[0], dtype=bool)
+    while True:
+        counts = np.bincount(labels, minlength=centers.shape[0])
+        rare = alive & (counts < floor)
+        if rare.sum() < 2:
+            break
+        d = _sq_distances(centers, centers)
+        d[:, ~alive] = np.inf
+        np.fill_diagonal(d, np.inf)
+        nearest = np.argmin(d, axis=1)
+        pairs = [(d[i, nearest[i]], i, nearest[i]) for i in np.flatnonzero(rare) if rare[nearest[i]]]
+        if not pairs:
+            break
+        _, i, j = min(pairs)
+        labels[labels == j] = i
+        alive[j] = False
+        centers[i] = Z[labels == i].mean(axis=0)
+    keep = np.flatnonzero(alive)
+    remap = np.full(centers.shape[0], -1)
+    remap[keep] = np.arange(keep.size)
+    return remap[labels], centers[keep]
+
+
 def _sq_distances(Z: np.ndarray, centers: np.ndarray) -> np.ndarray:
     """Squared Euclidean distances (n, k) of rows to centres."""
     return (Z * Z).sum(1)[:, None] - 2.0 * Z @ centers.T + (centers * centers).sum(1)[None, :]
@@ -313,6 +348,8 @@ class EffectCategories(BaseEstimator):
                 xm = XMeans(k_max=self.k_max, random_state=self._seed(rng)).fit(Zc)
                 lab, cen = xm.labels_, xm.cluster_centers_
                 channel_k_max[name] = self.k_max
+            if self.prune == "frequency" and self.method == "hierarchical":
+                lab, cen = _merge_rare(Zc, lab, cen, self.min_fraction * n)
             new_id = _order_by_count(lab, cen)
             lab = new_id[lab]
             cen = cen[np.argsort(new_id)]

@@ -27,7 +27,7 @@ What the behaviours do (all aimed at the perceived contact point, CP)
     - ``power-grasp(alpha)``: the open hand comes along d(alpha) until the palm touches the
       object or reaches the CP; every finger closes into a fist; the hand rises 25 cm.
     - ``precision-grasp(alpha)``: the open hand comes along d(alpha) until the point where
-      the thumb's and index's tips meet reaches 3 cm past the CP (or the palm touches);
+      the thumb's and index's tips meet reaches 5.5 cm past the CP (or the palm touches);
       only those two close, into a pinch; the hand rises 25 cm.
 
     A behaviour whose CP lies beyond the arm's reach does not start. The grasp and push
@@ -64,6 +64,15 @@ GRASP_OUTCOMES = ("fell", "left-view", "lifted", "slipping", "dragged", "no-chan
 #: The hand works this far below the contact point (metres): the CP is on the visible
 #: surface's edge nearest the robot, at the top of a box or a cylinder.
 GRASP_BELOW = 0.045
+
+#: How far past the CP a push takes the fist's front (metres; thesis 9.3.2).
+PUSH = 0.10
+
+#: Where a precision grasp's approach ends: the thumb's and index's tips meet this far past
+#: the CP (metres). Earlier sessions wrote 3 cm against a pinch point computed as if the
+#: tips could cross; where they really meet (``FingerHandConfig.tips_meet``) puts it here,
+#: which is what every measurement of this hand so far was made with.
+PINCH_PAST = 0.055
 
 #: Where a power grasp's approach ends: the palm's face this far past the CP (metres).
 POWER_PAST = 0.01
@@ -210,10 +219,10 @@ def _push_object(world: GraspWorld, target: np.ndarray, alpha: np.ndarray) -> Ex
     d = _direction(float(alpha[0]))
     at, start = _start_of(world, target, d)
     at[2] = start[2] = world.config.table_top + cfg.palm_half[2] + 0.008
-    fist = cfg.palm_half[0] + 0.01
     if not _approach(world, start, at, float(math.radians(alpha[0])), cfg.finger_closed):
         return Execution(False)
-    _move(world, at + d * (0.10 - fist), world.hand.yaw, speed=0.4)
+    # the fist's front (the closed fingers, not the palm) goes 10 cm past the CP
+    _move(world, at + d * (PUSH - cfg.fist_front), world.hand.yaw, speed=0.4)
     _go_home(world, d)
     return Execution(True)
 
@@ -227,7 +236,7 @@ def _grasp(fingers: tuple[str, ...], grip: str):
         at, start = _start_of(world, target, d)
         if not _approach(world, start, at, yaw, cfg.finger_open):
             return Execution(False)
-        stand = cfg.palm_half[0] - POWER_PAST if grip == "fist" else cfg.pinch_reach - 0.03
+        stand = cfg.palm_half[0] - POWER_PAST if grip == "fist" else cfg.pinch_reach - PINCH_PAST
         _move(world, at - d * stand, yaw, speed=0.3, guarded=True)
         hand.set_fingers(cfg.finger_closed, fingers, grip)
         world.step(int(0.7 / world.config.timestep), watch_contacts=True)

@@ -99,3 +99,28 @@ def test_a_grasp_episode_replays_to_the_same_bytes():
     a, b = (run_episode(SCENE, seed=3, episode=2) for _ in range(2))
     assert a.entities.tobytes() == b.entities.tobytes() and np.array_equal(a.params, b.params)
     assert a.params.shape[1] == 1 and len(a)
+
+
+def test_the_closed_fist_stands_where_the_push_assumes():
+    """Index and thumb close towards each other and stop where they meet; the push aims the
+    fist's front, not the palm, so the config must say where that front really is."""
+    world = SCENE.build([ObjectSpec("box", (0.08, 0.08, 0.08), (0.70, 0.40), 0.0)], np.random.default_rng(0))
+    cfg = world.config.hand
+    world.hand.set_fingers(cfg.finger_closed)
+    world.step(120)
+    front = max(world.hand.fingertip(n)[0] - world.hand.position[0] for n in ("index", "middle", "thumb"))
+    assert front + cfg.finger_half == pytest.approx(cfg.fist_front, abs=0.005)
+    assert front == pytest.approx(cfg.pinch_reach, abs=0.005)
+
+
+@pytest.mark.parametrize("alpha", [0.0, 30.0])
+def test_a_push_moves_a_box_about_ten_centimetres_along_alpha(alpha):
+    """push-object(alpha) is a 10 cm push (thesis 9.3.2), not the fist's length more."""
+    world = SCENE.build([ObjectSpec("box", (0.10, 0.10, 0.10), (0.65, 0.0), 0.0)], np.random.default_rng(0))
+    f = world.perceive()
+    step = interact(world, SCENE.behaviors[NAMES.index("push-object")], 0, np.array([alpha]), before=f)
+    moved = step.truth_after[0].position[:2] - step.truth_before[0].position[:2]
+    assert SCENE.outcomes[step.outcomes[0]] == "dragged"
+    assert 0.06 <= np.linalg.norm(moved) <= 0.14
+    heading = np.degrees(np.arctan2(moved[1], moved[0]))
+    assert abs(heading - alpha) < 20.0

@@ -166,6 +166,21 @@ def test_product_categories_under_threshold_are_dropped():
     assert (ec.labels_[rare] == -1).all() and (ec.labels_[~rare] >= 0).all()
 
 
+def test_a_rare_effect_split_in_two_by_x_means_is_kept_whole_and_a_lone_rare_one_dropped():
+    """Lifts that end left or right of where they started: two modes of 2 % each, nearer each
+    other than anything else. Pruned part by part the effect would vanish; kept whole it is 4 %."""
+    rng = np.random.default_rng(3)
+    centres = np.array([[0.0, 0.0, 0.0], [0.0, 0.10, 0.50], [0.0, -0.10, 0.50], [-0.6, 0.0, 0.0]])
+    sizes = (930, 20, 20, 15)  # still, lifted-left, lifted-right, a lone rare shove
+    kind = np.repeat(np.arange(4), sizes)
+    E = centres[kind] + rng.normal(0, 0.01, (kind.size, 3))
+    ec = EffectCategories(schema=("position",) * 3, k_max=4, random_state=0).fit(E)
+    assert ec.n_categories_ == 2
+    assert len(set(ec.labels_[(kind == 1) | (kind == 2)])) == 1 and ec.labels_[kind == 1][0] >= 0
+    assert (ec.labels_[kind == 3] == -1).all()
+    assert ec.prototypes_[1, 2] == pytest.approx(0.50, abs=0.01)  # the lift's mean rise
+
+
 def test_predictability_collapses_unpredictable_channel():
     rng = np.random.default_rng(0)
     n = 900

@@ -337,3 +337,19 @@ def test_navigation_runs_every_controller_in_every_room_beside_the_random_baseli
         assert all(r["moves"] <= 6 and r["failed_moves"] <= r["moves"] for r in runs)
     assert doc["summary"]["random"]["times_random"] in (1.0, None)
     assert (tmp_path / "sec_5_6_5_navigation.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_figure_9_8_neighbour_agreement_reads_a_planted_map():
+    """The map's own predictability: a smooth band is told by its neighbours, stripes that
+    flip with every yaw never."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("grasp_script", SCRIPTS / "tables_9_1_9_2_grasp.py")
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    grid = [(y, a) for y in range(-90, 91, 10) for a in range(-70, 41, 10)]
+    band = [{"yaw": y, "alpha": a, "real": int(abs(a - y) <= 20)} for y, a in grid]
+    stripes = [{"yaw": y, "alpha": a, "real": (y // 10) % 2} for y, a in grid]
+    assert script.neighbour_agreement(band, lambda r: r["real"]) > 0.85
+    assert script.neighbour_agreement(stripes, lambda r: r["real"]) == 0.0
+    assert script.neighbour_agreement([], lambda r: r["real"]) is None

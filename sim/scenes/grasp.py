@@ -66,7 +66,9 @@ class GraspScene(TableScene):
     #: point, and split the rare lifts into products too small to keep), with at most 4
     #: X-means clusters a channel (the tables have 2 a channel; with 5, X-means splits the
     #: power grasp's lifts by where the object went, and frequency pruning drops both parts:
-    #: measured on 30 000 interactions, lifted survives with 2, 3 or 4 and not with 5).
+    #: measured on 30 000 interactions, lifted survives with 2, 3 or 4 and not with 5; rare
+    #: parts nearest each other are now joined before pruning, ``learn.effects._merge_rare``,
+    #: which on 8000 interactions of seed 1 kept the pinch's lifts that 4 had split).
     clustering = {"channels": ["visibility", "cp", "touch"], "k_max": 4}
     #: ``afford select-features``' default: ReliefF's ranking is cut by the calibrated
     #: probabilities' log loss, not by accuracy. Lifts are rare (4-6 % of grasps) and
