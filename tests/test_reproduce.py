@@ -201,6 +201,8 @@ def test_grasp_tables_write_md_png_json_with_the_thesis_beside_ours(tmp_path):
     assert doc["summary"]["map_never_lifted_agreement"] == pytest.approx(1 - np.mean(lifted))
     # a cell whose category is right is right on lifted-or-not too
     assert doc["summary"]["map_agreement"] <= doc["summary"]["map_lift_agreement"] <= 1
+    # the map's own neighbours (30-degree steps in quick mode) are scored too
+    assert all(0.0 <= doc["summary"][k] <= 1 for k in ("map_neighbour_agreement", "map_neighbour_lift_agreement"))
     assert "Table 9.1" in (tmp_path / "tables_9_1_9_2_grasp.md").read_text()
     assert (tmp_path / "tables_9_1_9_2_grasp.png").read_bytes()[:4] == b"\x89PNG"
 
