@@ -99,7 +99,7 @@ def _merge_rare(Z: np.ndarray, labels: np.ndarray, centers: np.ndarray, floor: f
     Returns compacted ``(labels, centers)``.
     """
     labels, centers = labels.copy(), centers.copy()
-    alive = np.ones(centers.shape[0], dtype=bool)
+    alive = np.bincount(labels, minlength=centers.shape[0]) > 0  # an empty cluster joins nothing
     while True:
         counts = np.bincount(labels, minlength=centers.shape[0])
         rare = alive & (counts < floor)
